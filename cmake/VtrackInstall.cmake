@@ -1,0 +1,29 @@
+# cmake --install: executables, the core and message libraries with their headers, the generated
+# message headers, the jar, and a CMake package so that other projects can find_package(vtrack).
+include(CMakePackageConfigHelpers)
+
+install(TARGETS vtrack_msgs vtrack_core EXPORT vtrackTargets
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(FILES ${VTRACK_GENERATED_HEADERS} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/vtrack)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/tracker/core/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/vtrack/tracker/core
+  FILES_MATCHING PATTERN "*.h")
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/lcmtypes/util/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/vtrack/lcmtypes/util
+  FILES_MATCHING PATTERN "*.h")
+install(FILES ${VTRACK_LCM_FILES_ALL} DESTINATION ${CMAKE_INSTALL_DATADIR}/vtrack/lcmtypes)
+if(VTRACK_BUILD_JAVA)
+  install(FILES ${VTRACK_JAR} DESTINATION ${CMAKE_INSTALL_DATADIR}/java)
+endif()
+install(PROGRAMS ${PROJECT_SOURCE_DIR}/scripts/vtrack-netns DESTINATION ${CMAKE_INSTALL_BINDIR})
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/config/ DESTINATION ${CMAKE_INSTALL_DATADIR}/vtrack/config)
+
+install(EXPORT vtrackTargets NAMESPACE vtrack:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/vtrack)
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/vtrackConfig.cmake.in
+  ${CMAKE_CURRENT_BINARY_DIR}/vtrackConfig.cmake
+  INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/vtrack)
+write_basic_package_version_file(${CMAKE_CURRENT_BINARY_DIR}/vtrackConfigVersion.cmake
+  COMPATIBILITY SameMinorVersion)
+install(FILES ${CMAKE_CURRENT_BINARY_DIR}/vtrackConfig.cmake
+  ${CMAKE_CURRENT_BINARY_DIR}/vtrackConfigVersion.cmake
+  DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/vtrack)

@@ -1,0 +1,31 @@
+// Paths and guards shared by the tests (set by tests/CMakeLists.txt through the environment).
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "lcmtypes/util/process.h"
+
+namespace vtrack::testing {
+
+std::string SourceDir();   // repository root
+std::string BinDir();      // built executables
+std::string DataDir();     // ../shared/data (may not exist)
+std::string JarPath();     // the message types' jar, "" if not built
+// A fresh empty directory under the system temp dir, removed by nothing (inspect after failure).
+std::string ScratchDir(const std::string& name);
+// The KITTI tracking sequence 0000 directory if present, else "".
+std::string KittiDir();
+
+}  // namespace vtrack::testing
+
+// Refuses to open udpm:// outside a private loopback-only network namespace: multicast must never
+// leave the machine. ctest runs such tests through scripts/vtrack-netns.
+#define VTRACK_REQUIRE_PRIVATE_NETNS()                                                    \
+  do {                                                                                    \
+    if (!::vtrack::lcm_util::InPrivateLoopbackNamespace()) {                              \
+      GTEST_SKIP() << "not in a private loopback-only network namespace; run through "    \
+                      "scripts/vtrack-netns (ctest does) so multicast stays on this machine"; \
+    }                                                                                     \
+  } while (0)

@@ -1,0 +1,99 @@
+#!/usr/bin/env bash
+# vtrack: the one entry point. Installs what is missing (Debian 12 packages), builds, and runs.
+#
+#   ./vtrack.sh demo [DEMO OPTIONS]   the main job (see ./vtrack.sh demo --help)
+#   ./vtrack.sh test [CTEST ARGS]     every test (what CI runs)
+#   ./vtrack.sh bench [--json F]      the benchmarks
+#   ./vtrack.sh build                 set up and build only
+#   ./vtrack.sh deps                  install the Debian packages only
+#
+# Environment: VTRACK_BUILD_DIR (default ./build), VTRACK_JOBS (default 2).
+set -euo pipefail
+
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+build_dir=${VTRACK_BUILD_DIR:-$here/build}
+jobs=${VTRACK_JOBS:-2}
+
+# Debian 12 packages, by purpose. Each command installs only what it needs and is missing.
+pkgs_build=(g++ make cmake pkg-config
+  liblcm-dev liblcm-bin liblcm-java
+  libeigen3-dev libyaml-cpp-dev libboost-program-options-dev
+  libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev
+  libgtest-dev libbenchmark-dev default-jdk-headless)
+pkgs_run=(iproute2 procps zstd tar)
+pkgs_test=(xvfb xauth default-jre libjchart2d-java)
+pkgs_bench=()
+
+usage() { sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; }
+
+log() { printf '\033[1m[vtrack]\033[0m %s\n' "$*" >&2; }
+
+install_packages() {
+  local missing=() p
+  for p in "$@"; do
+    if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed'; then
+      missing+=("$p")
+    fi
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  local sudo=()
+  if [ "$(id -u)" != 0 ]; then
+    if command -v sudo >/dev/null 2>&1 && sudo -n true 2>/dev/null; then
+      sudo=(sudo -n)
+    else
+      log "missing Debian packages: ${missing[*]}"
+      log "not root and no password-less sudo: install them with"
+      log "  sudo apt-get install ${missing[*]}"
+      exit 1
+    fi
+  fi
+  log "installing Debian packages: ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo[@]}" apt-get update -qq
+  "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+}
+
+configure_and_build() {
+  local type=${1:-Release}; shift || true
+  log "building ($type) in $build_dir with $jobs jobs"
+  cmake -S "$here" -B "$build_dir" -DCMAKE_BUILD_TYPE="$type" "$@" >/dev/null
+  cmake --build "$build_dir" -j "$jobs"
+}
+
+cmd=${1:-help}
+shift || true
+case "$cmd" in
+  -h|--help|help)
+    usage ;;
+  deps)
+    install_packages "${pkgs_build[@]}" "${pkgs_run[@]}" "${pkgs_test[@]}" "${pkgs_bench[@]}" ;;
+  build)
+    install_packages "${pkgs_build[@]}" "${pkgs_run[@]}"
+    configure_and_build Release ;;
+  test)
+    install_packages "${pkgs_build[@]}" "${pkgs_run[@]}" "${pkgs_test[@]}"
+    configure_and_build Release
+    start=$(date +%s)
+    log "running every test (ctest)"
+    ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" "$@"
+    log "tests passed in $(( $(date +%s) - start )) s" ;;
+  bench)
+    install_packages "${pkgs_build[@]}" "${pkgs_run[@]}" "${pkgs_bench[@]}"
+    configure_and_build Release -DVTRACK_BUILD_BENCHMARKS=ON
+    found=0
+    for b in "$build_dir"/bench/*; do
+      [ -x "$b" ] || continue
+      found=1
+      log "benchmark $(basename "$b")"
+      "$b" "$@"
+    done
+    [ $found = 1 ] || log "no benchmark programs are built yet" ;;
+  demo)
+    install_packages "${pkgs_build[@]}" "${pkgs_run[@]}"
+    configure_and_build Release
+    exec "$here/scripts/demo.sh" "$build_dir" "$@" ;;
+  *)
+    log "unknown command '$cmd'"
+    usage
+    exit 2 ;;
+esac

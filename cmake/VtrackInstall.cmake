@@ -21,7 +21,8 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/config/ DESTINATION ${CMAKE_INSTALL_DATA
 install(EXPORT vtrackTargets NAMESPACE vtrack:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/vtrack)
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/vtrackConfig.cmake.in
   ${CMAKE_CURRENT_BINARY_DIR}/vtrackConfig.cmake
-  INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/vtrack)
+  INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/vtrack
+  PATH_VARS CMAKE_INSTALL_INCLUDEDIR CMAKE_INSTALL_DATADIR)
 write_basic_package_version_file(${CMAKE_CURRENT_BINARY_DIR}/vtrackConfigVersion.cmake
   COMPATIBILITY SameMinorVersion)
 install(FILES ${CMAKE_CURRENT_BINARY_DIR}/vtrackConfig.cmake

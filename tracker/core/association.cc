@@ -1,0 +1,362 @@
+#include "tracker/core/association.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <sstream>
+
+#include "tracker/core/angle.h"
+
+namespace vtrack {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+std::string Bad(const char* key, double value, const char* constraint) {
+  std::ostringstream os;
+  os << "association." << key << " = " << value << ": " << constraint;
+  return os.str();
+}
+
+// Signed distance of a box-frame point to the rectangle boundary: > 0 outside, <= 0 inside.
+double SignedBoxDistance(const Eigen::Vector2d& q, double half_l, double half_w) {
+  const double dx = std::abs(q.x()) - half_l;
+  const double dy = std::abs(q.y()) - half_w;
+  if (dx > 0.0 || dy > 0.0) return std::hypot(std::max(dx, 0.0), std::max(dy, 0.0));
+  return std::max(dx, dy);
+}
+
+// Distance of a box-frame point to face f (a segment of the rectangle boundary).
+double FaceDistance(const Eigen::Vector2d& q, Face f, double half_l, double half_w) {
+  switch (f) {
+    case Face::kFront: return std::hypot(q.x() - half_l, std::max(std::abs(q.y()) - half_w, 0.0));
+    case Face::kRear: return std::hypot(q.x() + half_l, std::max(std::abs(q.y()) - half_w, 0.0));
+    case Face::kLeft: return std::hypot(q.y() - half_w, std::max(std::abs(q.x()) - half_l, 0.0));
+    case Face::kRight: return std::hypot(q.y() + half_w, std::max(std::abs(q.x()) - half_l, 0.0));
+  }
+  return kInf;
+}
+
+bool Overlap(const Eigen::Vector2d& amin, const Eigen::Vector2d& amax, const Eigen::Vector2d& bmin,
+             const Eigen::Vector2d& bmax) {
+  return amin.x() <= bmax.x() && bmin.x() <= amax.x() && amin.y() <= bmax.y() &&
+         bmin.y() <= amax.y();
+}
+
+void GateBounds(const OrientedBox& box, double margin, Eigen::Vector2d* lo, Eigen::Vector2d* hi) {
+  OrientedBox grown = box;
+  grown.length += 2.0 * margin;
+  grown.width += 2.0 * margin;
+  *lo = Eigen::Vector2d::Constant(kInf);
+  *hi = -*lo;
+  for (const auto& c : grown.Corners()) {
+    *lo = lo->cwiseMin(c);
+    *hi = hi->cwiseMax(c);
+  }
+}
+
+struct UnionFind {
+  std::vector<int> parent;
+  explicit UnionFind(int n) : parent(static_cast<std::size_t>(n)) {
+    std::iota(parent.begin(), parent.end(), 0);
+  }
+  int Find(int a) {
+    while (parent[static_cast<std::size_t>(a)] != a) {
+      parent[static_cast<std::size_t>(a)] =
+          parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(a)])];
+      a = parent[static_cast<std::size_t>(a)];
+    }
+    return a;
+  }
+  void Join(int a, int b) { parent[static_cast<std::size_t>(Find(a))] = Find(b); }
+};
+
+}  // namespace
+
+bool AssociationParams::Validate(std::string* error) const {
+  const std::string e = FirstProblem();
+  if (!e.empty() && error) *error = e;
+  return e.empty();
+}
+
+std::string AssociationParams::FirstProblem() const {
+  if (!(gate_margin >= 0.0)) return Bad("gate_margin", gate_margin, "must be >= 0");
+  if (!(gate_sigma >= 0.0)) return Bad("gate_sigma", gate_sigma, "must be >= 0");
+  if (!(max_gate_margin >= gate_margin))
+    return Bad("max_gate_margin", max_gate_margin, "must be >= gate_margin");
+  if (!(min_inside_fraction > 0.0 && min_inside_fraction <= 1.0))
+    return Bad("min_inside_fraction", min_inside_fraction, "must be in (0, 1]");
+  if (!(outside_penalty >= 0.0)) return Bad("outside_penalty", outside_penalty, "must be >= 0");
+  if (!(miss_cost > 0.0)) return Bad("miss_cost", miss_cost, "must be > 0");
+  if (!(merge_fraction > 0.0 && merge_fraction <= 1.0))
+    return Bad("merge_fraction", merge_fraction, "must be in (0, 1]");
+  if (split_min_points < 1) return Bad("split_min_points", split_min_points, "must be >= 1");
+  if (!(min_slant_deg >= 0.0 && min_slant_deg < 90.0))
+    return Bad("min_slant_deg", min_slant_deg, "must be in [0, 90)");
+  return {};
+}
+
+std::vector<int> SolveAssignment(const std::vector<double>& cost, int rows, int cols) {
+  // Shortest augmenting paths with row/column potentials (Kuhn-Munkres, Jonker-Volgenant
+  // style); 1-based arrays with column 0 as the virtual start.
+  std::vector<double> u(static_cast<std::size_t>(rows) + 1, 0.0);
+  std::vector<double> v(static_cast<std::size_t>(cols) + 1, 0.0);
+  std::vector<int> p(static_cast<std::size_t>(cols) + 1, 0);    // row matched to column
+  std::vector<int> way(static_cast<std::size_t>(cols) + 1, 0);
+  std::vector<double> minv(static_cast<std::size_t>(cols) + 1);
+  std::vector<char> used(static_cast<std::size_t>(cols) + 1);
+  auto a = [&](int r, int c) {
+    return cost[static_cast<std::size_t>(r - 1) * static_cast<std::size_t>(cols) +
+                static_cast<std::size_t>(c - 1)];
+  };
+  for (int i = 1; i <= rows; ++i) {
+    p[0] = i;
+    int j0 = 0;
+    std::fill(minv.begin(), minv.end(), kInf);
+    std::fill(used.begin(), used.end(), 0);
+    do {
+      used[static_cast<std::size_t>(j0)] = 1;
+      const int i0 = p[static_cast<std::size_t>(j0)];
+      double delta = kInf;
+      int j1 = 0;
+      for (int j = 1; j <= cols; ++j) {
+        if (used[static_cast<std::size_t>(j)]) continue;
+        const double cur = a(i0, j) - u[static_cast<std::size_t>(i0)] - v[static_cast<std::size_t>(j)];
+        if (cur < minv[static_cast<std::size_t>(j)]) {
+          minv[static_cast<std::size_t>(j)] = cur;
+          way[static_cast<std::size_t>(j)] = j0;
+        }
+        if (minv[static_cast<std::size_t>(j)] < delta) {
+          delta = minv[static_cast<std::size_t>(j)];
+          j1 = j;
+        }
+      }
+      for (int j = 0; j <= cols; ++j) {
+        if (used[static_cast<std::size_t>(j)]) {
+          u[static_cast<std::size_t>(p[static_cast<std::size_t>(j)])] += delta;
+          v[static_cast<std::size_t>(j)] -= delta;
+        } else {
+          minv[static_cast<std::size_t>(j)] -= delta;
+        }
+      }
+      j0 = j1;
+    } while (p[static_cast<std::size_t>(j0)] != 0);
+    do {
+      const int j1 = way[static_cast<std::size_t>(j0)];
+      p[static_cast<std::size_t>(j0)] = p[static_cast<std::size_t>(j1)];
+      j0 = j1;
+    } while (j0 != 0);
+  }
+  std::vector<int> assign(static_cast<std::size_t>(rows), -1);
+  for (int j = 1; j <= cols; ++j) {
+    if (p[static_cast<std::size_t>(j)] > 0) assign[static_cast<std::size_t>(p[static_cast<std::size_t>(j)] - 1)] = j - 1;
+  }
+  return assign;
+}
+
+Associator::Associator(const AssociationParams& params) : params_(params) {}
+
+double Associator::GateMargin(const PredictedObject& t) const {
+  return std::min(params_.max_gate_margin,
+                  params_.gate_margin + params_.gate_sigma * std::max(0.0, t.position_std));
+}
+
+double Associator::PairCost(const PredictedObject& t, double margin, std::uint8_t visible,
+                            const Part& part, const WorldPoints& pts,
+                            double* inside_fraction) const {
+  const double hl = 0.5 * t.box.length, hw = 0.5 * t.box.width;
+  int inside = 0;
+  double dist_sum = 0.0;
+  for (const std::int32_t i : part.points) {
+    const auto iu = static_cast<std::size_t>(i);
+    const Eigen::Vector2d q = t.box.ToBoxFrame({pts.x[iu], pts.y[iu]});
+    if (std::abs(q.x()) > hl + margin || std::abs(q.y()) > hw + margin) continue;
+    ++inside;
+    double d = kInf;
+    for (int f = 0; f < 4; ++f) {
+      if (visible & (1u << f)) d = std::min(d, FaceDistance(q, static_cast<Face>(f), hl, hw));
+    }
+    dist_sum += d;
+  }
+  const double frac = part.points.empty() ? 0.0 : static_cast<double>(inside) / part.points.size();
+  *inside_fraction = frac;
+  if (inside == 0 || frac < params_.min_inside_fraction) return kInf;
+  return dist_sum / inside + params_.outside_penalty * (1.0 - frac);
+}
+
+void Associator::BuildParts(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
+                            const Segments& segments) {
+  parts_.clear();
+  std::vector<Eigen::Vector2d> lo(tracks.size()), hi(tracks.size());
+  for (std::size_t j = 0; j < tracks.size(); ++j) {
+    GateBounds(tracks[j].box, GateMargin(tracks[j]), &lo[j], &hi[j]);
+  }
+  std::vector<std::size_t> claim;
+  for (const Segment& s : segments.segments) {
+    // Established tracks with enough of this segment's returns inside their gate.
+    claim.clear();
+    for (std::size_t j = 0; j < tracks.size(); ++j) {
+      if (!tracks[j].established || !Overlap(s.min, s.max, lo[j], hi[j])) continue;
+      const double margin = GateMargin(tracks[j]);
+      int inside = 0;
+      for (std::int32_t k = s.begin; k < s.end; ++k) {
+        const auto i = static_cast<std::size_t>(segments.point[static_cast<std::size_t>(k)]);
+        if (tracks[j].box.Contains({pts.x[i], pts.y[i]}, margin)) ++inside;
+      }
+      if (inside >= params_.split_min_points) claim.push_back(j);
+    }
+    const std::size_t first = parts_.size();
+    const std::size_t num_parts = claim.size() >= 2 ? claim.size() : 1;
+    parts_.resize(first + num_parts);
+    for (std::int32_t k = s.begin; k < s.end; ++k) {
+      const std::int32_t i = segments.point[static_cast<std::size_t>(k)];
+      std::size_t best = 0;
+      if (num_parts > 1) {
+        double best_d = kInf;
+        for (std::size_t c = 0; c < claim.size(); ++c) {
+          const OrientedBox& b = tracks[claim[c]].box;
+          const auto iu = static_cast<std::size_t>(i);
+          const double d = SignedBoxDistance(b.ToBoxFrame({pts.x[iu], pts.y[iu]}),
+                                             0.5 * b.length, 0.5 * b.width);
+          if (d < best_d) {
+            best_d = d;
+            best = c;
+          }
+        }
+      }
+      parts_[first + best].points.push_back(i);
+    }
+    // Bounding boxes; drop pieces of a split that are too small to fit.
+    std::size_t w = first;
+    for (std::size_t q = first; q < parts_.size(); ++q) {
+      Part& part = parts_[q];
+      if (num_parts > 1 && static_cast<int>(part.points.size()) < params_.split_min_points) continue;
+      part.min = Eigen::Vector2d::Constant(kInf);
+      part.max = -part.min;
+      for (const std::int32_t i : part.points) {
+        const Eigen::Vector2d p(pts.x[static_cast<std::size_t>(i)], pts.y[static_cast<std::size_t>(i)]);
+        part.min = part.min.cwiseMin(p);
+        part.max = part.max.cwiseMax(p);
+      }
+      if (w != q) parts_[w] = std::move(part);
+      ++w;
+    }
+    parts_.resize(w);
+  }
+}
+
+void Associator::Run(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
+                     const Segments& segments, const Eigen::Vector2d& sensor_xy,
+                     AssociationResult* out) {
+  const std::size_t nt = tracks.size();
+  out->track_points.resize(nt);
+  for (auto& v : out->track_points) v.clear();
+  out->track_cost.assign(nt, std::numeric_limits<double>::quiet_NaN());
+  out->new_objects.clear();
+  out->num_split = 0;
+  out->num_merged = 0;
+  out->num_ignored = 0;
+
+  BuildParts(tracks, pts, segments);
+  out->num_split = static_cast<std::int32_t>(parts_.size()) -
+                   static_cast<std::int32_t>(segments.segments.size());
+  if (out->num_split < 0) out->num_split = 0;
+  const std::size_t np = parts_.size();
+
+  // Candidate pairs and their costs.
+  struct Pair {
+    int track, part;
+    double cost, inside;
+  };
+  std::vector<Pair> pairs;
+  std::vector<double> margins(nt);
+  std::vector<Eigen::Vector2d> lo(nt), hi(nt);
+  const double slant = DegToRad(params_.min_slant_deg);
+  for (std::size_t j = 0; j < nt; ++j) {
+    margins[j] = GateMargin(tracks[j]);
+    GateBounds(tracks[j].box, margins[j], &lo[j], &hi[j]);
+    std::uint8_t visible = VisibleFaces(tracks[j].box, sensor_xy, slant);
+    if (visible == 0) visible = 0xF;  // sensor inside or on the rectangle: any face
+    for (std::size_t q = 0; q < np; ++q) {
+      if (!Overlap(parts_[q].min, parts_[q].max, lo[j], hi[j])) continue;
+      double inside = 0.0;
+      const double c = PairCost(tracks[j], margins[j], visible, parts_[q], pts, &inside);
+      if (std::isfinite(c)) pairs.push_back({static_cast<int>(j), static_cast<int>(q), c, inside});
+    }
+  }
+
+  // Connected components of the candidate graph: nodes 0..nt-1 tracks, nt.. parts.
+  UnionFind uf(static_cast<int>(nt + np));
+  for (const Pair& pr : pairs) uf.Join(pr.track, static_cast<int>(nt) + pr.part);
+  std::vector<int> part_track(np, -1);
+  {
+    std::vector<std::vector<int>> comp_tracks(nt + np), comp_parts(nt + np);
+    for (std::size_t j = 0; j < nt; ++j) comp_tracks[static_cast<std::size_t>(uf.Find(static_cast<int>(j)))].push_back(static_cast<int>(j));
+    for (std::size_t q = 0; q < np; ++q) comp_parts[static_cast<std::size_t>(uf.Find(static_cast<int>(nt + q)))].push_back(static_cast<int>(q));
+    std::vector<int> row_of(nt, -1), col_of(np, -1);
+    std::vector<std::vector<const Pair*>> pairs_by_comp(nt + np);
+    for (const Pair& pr : pairs) pairs_by_comp[static_cast<std::size_t>(uf.Find(pr.track))].push_back(&pr);
+    std::vector<double> cost;
+    for (std::size_t c = 0; c < nt + np; ++c) {
+      const auto& ct = comp_tracks[c];
+      const auto& cp = comp_parts[c];
+      if (ct.empty() || cp.empty()) continue;
+      const int rows = static_cast<int>(ct.size());
+      const int cols = static_cast<int>(cp.size()) + rows;  // + one "unassigned" column per row
+      for (int r = 0; r < rows; ++r) row_of[static_cast<std::size_t>(ct[static_cast<std::size_t>(r)])] = r;
+      for (std::size_t k = 0; k < cp.size(); ++k) col_of[static_cast<std::size_t>(cp[k])] = static_cast<int>(k);
+      // Not a candidate: far more than leaving the track unassigned, so never chosen.
+      const double kForbidden = 1e6;
+      cost.assign(static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols), kForbidden);
+      for (int r = 0; r < rows; ++r) {
+        cost[static_cast<std::size_t>(r) * cols + cp.size() + static_cast<std::size_t>(r)] = params_.miss_cost;
+      }
+      for (const Pair* pr : pairs_by_comp[c]) {
+        const int r = row_of[static_cast<std::size_t>(pr->track)];
+        const int k = col_of[static_cast<std::size_t>(pr->part)];
+        cost[static_cast<std::size_t>(r) * cols + static_cast<std::size_t>(k)] = pr->cost;
+      }
+      const std::vector<int> assign = SolveAssignment(cost, rows, cols);
+      for (int r = 0; r < rows; ++r) {
+        const int k = assign[static_cast<std::size_t>(r)];
+        if (k < 0 || k >= static_cast<int>(cp.size())) continue;
+        const double c_rk = cost[static_cast<std::size_t>(r) * cols + static_cast<std::size_t>(k)];
+        if (c_rk >= kForbidden) continue;
+        const int j = ct[static_cast<std::size_t>(r)];
+        const int q = cp[static_cast<std::size_t>(k)];
+        part_track[static_cast<std::size_t>(q)] = j;
+        out->track_cost[static_cast<std::size_t>(j)] = c_rk;
+        out->track_points[static_cast<std::size_t>(j)] = parts_[static_cast<std::size_t>(q)].points;
+      }
+    }
+  }
+
+  // Leftover parts: merge into an assigned track that holds most of them, else new objects.
+  for (std::size_t q = 0; q < np; ++q) {
+    if (part_track[q] >= 0) continue;
+    int best = -1;
+    double best_inside = 0.0;
+    for (const Pair& pr : pairs) {
+      if (pr.part != static_cast<int>(q)) continue;
+      if (out->track_points[static_cast<std::size_t>(pr.track)].empty()) continue;
+      if (pr.inside >= params_.merge_fraction && pr.inside > best_inside) {
+        best_inside = pr.inside;
+        best = pr.track;
+      }
+    }
+    const bool candidate = std::any_of(pairs.begin(), pairs.end(),
+                                       [&](const Pair& pr) { return pr.part == static_cast<int>(q); });
+    if (best >= 0) {
+      auto& dst = out->track_points[static_cast<std::size_t>(best)];
+      dst.insert(dst.end(), parts_[q].points.begin(), parts_[q].points.end());
+      ++out->num_merged;
+    } else if (candidate) {
+      ++out->num_ignored;  // inside some track's gate: not a new object, not a measurement
+    } else {
+      out->new_objects.push_back(std::move(parts_[q].points));
+    }
+  }
+}
+
+}  // namespace vtrack

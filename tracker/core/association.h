@@ -1,0 +1,106 @@
+// Association of segments to tracks (not in the paper; DESIGN section 4): by the predicted
+// rectangle and its visible faces, with one global assignment.
+//
+// For each track, the predicted rectangle grown by a gate margin (gate_margin + gate_sigma *
+// predicted position std, at most max_gate_margin) is the gate. A segment is a candidate for a
+// track if at least min_inside_fraction of its returns fall inside the gate. The cost of the
+// pair is
+//     cost = mean over inside returns of the distance to the nearest visible face of the
+//            predicted rectangle (Eq. 15 per-face visibility, DESIGN note 4)
+//          + outside_penalty * (1 - inside fraction),
+// so a segment that lies where the sensor should see the vehicle's faces is preferred over one
+// that merely overlaps it. One global minimum-cost assignment (Hungarian method, solved per
+// connected component of the candidate graph, so its cubic cost applies only to small groups)
+// pairs tracks and segments one to one; a track may stay unassigned at cost miss_cost.
+//
+// Around the assignment:
+//  - split: a segment that is a candidate of two or more established tracks (two parked cars
+//    merged by the grid) is split between them, each return going to the rectangle it is
+//    nearest to, before the assignment;
+//  - merge: an unassigned segment with at least merge_fraction of its returns inside the gate
+//    of an assigned track joins that track (an object cut in two by an occluder);
+//  - a leftover that is a candidate of some track but not merged is ignored (it would
+//    otherwise seed a duplicate of that track);
+//  - what remains unassigned seeds new tracks.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tracker/core/box.h"
+#include "tracker/core/preprocess.h"
+#include "tracker/core/segmentation.h"
+
+namespace vtrack {
+
+struct AssociationParams {
+  double gate_margin = 0.8;          // [m] predicted rectangle grown by this on every side
+  double gate_sigma = 3.0;           // [-] plus this many predicted position standard deviations
+  double max_gate_margin = 4.0;      // [m] upper bound of the total growth
+  double min_inside_fraction = 0.3;  // [-] of a segment's returns inside the gate to be a candidate
+  double outside_penalty = 2.0;      // [m] cost per unit fraction of returns outside the gate
+  double miss_cost = 3.0;            // [m] cost of leaving a track unassigned
+  double merge_fraction = 0.6;       // [-] leftover segment joins an assigned track above this
+  int split_min_points = 3;          // [-] each part of a split segment has at least this many
+  double min_slant_deg = 10.0;       // [deg] s in Eq. 15
+
+  // True if every field is valid; otherwise false and *error names the key and its value.
+  bool Validate(std::string* error) const;
+  std::string FirstProblem() const;  // "" if valid
+};
+
+// What association needs to know of a track: its predicted rectangle and uncertainty.
+struct PredictedObject {
+  OrientedBox box;                   // predicted rectangle at the scan time
+  double position_std = 0.0;         // [m] sqrt of the largest eigenvalue of the xy covariance
+  bool established = false;          // confirmed or coasting (may claim part of a split segment)
+};
+
+struct AssociationResult {
+  // For each track (same order as the input), the returns assigned to it (indices into
+  // WorldPoints); empty if none.
+  std::vector<std::vector<std::int32_t>> track_points;
+  // Cost of the assignment of each track (NaN if unassigned).
+  std::vector<double> track_cost;
+  // Segments left over (new objects), as lists of WorldPoints indices.
+  std::vector<std::vector<std::int32_t>> new_objects;
+  std::int32_t num_split = 0;   // segments split between tracks
+  std::int32_t num_merged = 0;  // leftover segments merged into a track
+  std::int32_t num_ignored = 0; // leftover segments inside a track's gate but not merged
+};
+
+// Solves min sum cost[r][assign[r]] over one-to-one assignments of rows to columns
+// (rows <= cols), cost row-major rows x cols. Returns assign (column per row). Hungarian method
+// with potentials, O(rows^2 cols). Hand-written: the core depends on Eigen only, and the
+// assignment is 60 lines that a brute-force test checks.
+std::vector<int> SolveAssignment(const std::vector<double>& cost, int rows, int cols);
+
+class Associator {
+ public:
+  explicit Associator(const AssociationParams& params);
+
+  void Run(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
+           const Segments& segments, const Eigen::Vector2d& sensor_xy, AssociationResult* out);
+
+  // Grown gate of a predicted object.
+  double GateMargin(const PredictedObject& t) const;
+
+ private:
+  struct Part {  // a segment, or one piece of a split segment
+    std::vector<std::int32_t> points;
+    Eigen::Vector2d min, max;
+  };
+  void BuildParts(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
+                  const Segments& segments);
+  // Cost of (track, part), or +inf if the part is not a candidate of the track.
+  double PairCost(const PredictedObject& t, double margin, std::uint8_t visible, const Part& p,
+                  const WorldPoints& pts, double* inside_fraction) const;
+
+  AssociationParams params_;
+  std::vector<Part> parts_;
+};
+
+}  // namespace vtrack

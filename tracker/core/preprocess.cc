@@ -1,0 +1,268 @@
+#include "tracker/core/preprocess.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace vtrack {
+namespace {
+
+std::string Bad(const char* key, double value, const char* constraint) {
+  std::ostringstream os;
+  os << "preprocess." << key << " = " << value << ": " << constraint;
+  return os.str();
+}
+
+}  // namespace
+
+const char* ToString(PreprocessParams::Ground g) {
+  switch (g) {
+    case PreprocessParams::Ground::kNone: return "none";
+    case PreprocessParams::Ground::kBand: return "band";
+    case PreprocessParams::Ground::kGrid: return "grid";
+  }
+  return "?";
+}
+
+bool ParseGround(const std::string& s, PreprocessParams::Ground* g) {
+  if (s == "none") *g = PreprocessParams::Ground::kNone;
+  else if (s == "band") *g = PreprocessParams::Ground::kBand;
+  else if (s == "grid") *g = PreprocessParams::Ground::kGrid;
+  else return false;
+  return true;
+}
+
+bool PreprocessParams::Validate(std::string* error) const {
+  const std::string e = FirstProblem();
+  if (!e.empty() && error) *error = e;
+  return e.empty();
+}
+
+std::string PreprocessParams::FirstProblem() const {
+  if (!(min_range >= 0.0)) return Bad("min_range", min_range, "must be >= 0");
+  if (!(max_range > min_range)) return Bad("max_range", max_range, "must be > min_range");
+  if (max_range > 1000.0) return Bad("max_range", max_range, "must be <= 1000");
+  if (ground_min_rings < 1) return Bad("ground_min_rings", ground_min_rings, "must be >= 1");
+  if (!std::isfinite(ground_height_body))
+    return Bad("ground_height_body", ground_height_body, "must be finite");
+  if (!(max_height > min_height)) return Bad("max_height", max_height, "must be > min_height");
+  if (!std::isfinite(min_height)) return Bad("min_height", min_height, "must be finite");
+  if (!(ground_cell >= 0.1 && ground_cell <= 10.0))
+    return Bad("ground_cell", ground_cell, "must be in [0.1, 10]");
+  if (!(ground_tolerance >= 0.0)) return Bad("ground_tolerance", ground_tolerance, "must be >= 0");
+  if (!(ground_max_slope >= 0.0 && ground_max_slope <= 1.0))
+    return Bad("ground_max_slope", ground_max_slope, "must be in [0, 1]");
+  if (knot_us < 10 || knot_us > 100000)
+    return Bad("knot_us", static_cast<double>(knot_us), "must be in [10, 100000]");
+  if (max_points < 1) return Bad("max_points", static_cast<double>(max_points), "must be >= 1");
+  return {};
+}
+
+void WorldPoints::clear() {
+  x.clear();
+  y.clear();
+  height.clear();
+  index.clear();
+  ring.clear();
+}
+
+void WorldPoints::reserve(std::size_t n) {
+  x.reserve(n);
+  y.reserve(n);
+  height.reserve(n);
+  index.reserve(n);
+  ring.reserve(n);
+}
+
+void WorldPoints::push_back(double px, double py, float h, std::int32_t i, std::int16_t r) {
+  x.push_back(px);
+  y.push_back(py);
+  height.push_back(h);
+  index.push_back(i);
+  ring.push_back(r);
+}
+
+Preprocessor::Preprocessor(const PreprocessParams& params) : params_(params) {}
+
+PreprocessResult Preprocessor::Run(const LadarScan& scan, const PoseHistory& poses,
+                                   std::int64_t max_extrapolation_us, WorldPoints* out) {
+  PreprocessResult result;
+  out->clear();
+  const std::size_t n = scan.size();
+  result.stats.input = static_cast<std::int64_t>(n);
+
+  // Pose knots over the sweep [utime, utime + T].
+  const std::int64_t sweep = std::max<std::int64_t>(0, scan.sweep_duration_us);
+  const std::int64_t step = params_.knot_us;
+  const std::int64_t num_intervals = std::max<std::int64_t>(1, (sweep + step - 1) / step);
+  knot_m_.resize(static_cast<std::size_t>(num_intervals + 1));
+  knot_d_.resize(static_cast<std::size_t>(num_intervals));
+  bool extrapolated = false;
+  Eigen::Isometry3d world_from_body_start = Eigen::Isometry3d::Identity();
+  for (std::int64_t k = 0; k <= num_intervals; ++k) {
+    const std::int64_t t = scan.utime + std::min(k * step, sweep);
+    PoseHistory::LookupStatus st;
+    const auto world_from_body = poses.At(t, max_extrapolation_us, &st);
+    if (!world_from_body) {
+      result.status = CompensationStatus::kNoPose;
+      result.failed_lookup = st;
+      return result;
+    }
+    if (st == PoseHistory::LookupStatus::kExtrapolated) extrapolated = true;
+    if (k == 0) world_from_body_start = *world_from_body;
+    const Eigen::Matrix4d world_from_sensor = (*world_from_body * scan.body_from_sensor).matrix();
+    knot_m_[static_cast<std::size_t>(k)] = world_from_sensor.topRows<2>();
+  }
+  for (std::int64_t k = 0; k < num_intervals; ++k) {
+    knot_d_[static_cast<std::size_t>(k)] =
+        knot_m_[static_cast<std::size_t>(k + 1)] - knot_m_[static_cast<std::size_t>(k)];
+  }
+  result.status = extrapolated ? CompensationStatus::kExtrapolated : CompensationStatus::kOk;
+  result.world_from_body_start = world_from_body_start;
+  {
+    const std::int64_t mid = scan.utime + sweep / 2;
+    PoseHistory::LookupStatus st;
+    const auto world_from_body = poses.At(mid, max_extrapolation_us, &st);
+    const Eigen::Isometry3d wb = world_from_body ? *world_from_body : world_from_body_start;
+    result.sensor_xy = (wb * scan.body_from_sensor).translation().head<2>();
+  }
+
+  // Body-frame height of a return: the z row of body_from_sensor (the mounting is rigid).
+  const Eigen::Matrix<double, 1, 4> body_z = scan.body_from_sensor.matrix().row(2);
+  const double min_r2 = params_.min_range * params_.min_range;
+  const double max_r2 = params_.max_range * params_.max_range;
+  const bool has_ring = scan.ring.size() == n;
+  const bool has_dt = scan.dt_us.size() == n;
+  out->reserve(n);
+  body_z_.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    const double px = scan.x[i], py = scan.y[i], pz = scan.z[i];
+    if (!std::isfinite(px) || !std::isfinite(py) || !std::isfinite(pz)) {
+      ++result.stats.nonfinite;
+      continue;
+    }
+    const double r2 = px * px + py * py + pz * pz;
+    if (r2 < min_r2 || r2 > max_r2) {
+      ++result.stats.out_of_range;
+      continue;
+    }
+    const std::int64_t dt = has_dt ? scan.dt_us[i] : 0;
+    if (dt < 0 || dt > sweep) {
+      ++result.stats.bad_time;
+      continue;
+    }
+    const std::int64_t k = std::min<std::int64_t>(dt / step, num_intervals - 1);
+    const std::int64_t t0 = k * step;
+    const std::int64_t t1 = std::min((k + 1) * step, sweep);
+    const double f = t1 > t0 ? static_cast<double>(dt - t0) / static_cast<double>(t1 - t0) : 0.0;
+    const auto& m = knot_m_[static_cast<std::size_t>(k)];
+    const auto& d = knot_d_[static_cast<std::size_t>(k)];
+    const double wx = (m(0, 0) + f * d(0, 0)) * px + (m(0, 1) + f * d(0, 1)) * py +
+                      (m(0, 2) + f * d(0, 2)) * pz + (m(0, 3) + f * d(0, 3));
+    const double wy = (m(1, 0) + f * d(1, 0)) * px + (m(1, 1) + f * d(1, 1)) * py +
+                      (m(1, 2) + f * d(1, 2)) * pz + (m(1, 3) + f * d(1, 3));
+    const double zb = body_z(0) * px + body_z(1) * py + body_z(2) * pz + body_z(3);
+    out->push_back(wx, wy, static_cast<float>(zb), static_cast<std::int32_t>(i),
+                   has_ring ? scan.ring[i] : std::int16_t{0});
+  }
+
+  const bool cloud_3d = scan.num_rings >= params_.ground_min_rings;
+  if (cloud_3d && params_.ground == PreprocessParams::Ground::kGrid) {
+    RemoveGround(result.sensor_xy, out, &result.stats);
+  } else if (cloud_3d && params_.ground == PreprocessParams::Ground::kBand) {
+    std::size_t w = 0;
+    for (std::size_t i = 0; i < out->size(); ++i) {
+      const float h = out->height[i] - static_cast<float>(params_.ground_height_body);
+      if (h < params_.min_height || h > params_.max_height) continue;
+      out->x[w] = out->x[i];
+      out->y[w] = out->y[i];
+      out->height[w] = h;
+      out->index[w] = out->index[i];
+      out->ring[w] = out->ring[i];
+      ++w;
+    }
+    result.stats.ground = static_cast<std::int64_t>(out->size() - w);
+    out->x.resize(w);
+    out->y.resize(w);
+    out->height.resize(w);
+    out->index.resize(w);
+    out->ring.resize(w);
+  }
+  result.stats.kept = static_cast<std::int64_t>(out->size());
+  return result;
+}
+
+void Preprocessor::RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts,
+                                PreprocessStats* stats) {
+  const double cell = params_.ground_cell;
+  const int side = static_cast<int>(std::ceil(2.0 * params_.max_range / cell)) + 3;
+  const double x0 = center.x() - 0.5 * side * cell;
+  const double y0 = center.y() - 0.5 * side * cell;
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  cell_min_.assign(static_cast<std::size_t>(side) * side, kInf);
+  cell_ground_.assign(static_cast<std::size_t>(side) * side, std::numeric_limits<float>::quiet_NaN());
+  const std::size_t n = pts->size();
+  point_cell_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    // Within max_range of the sensor, hence inside the grid (with one spare ring of cells).
+    const int cx = std::clamp(static_cast<int>((pts->x[i] - x0) / cell), 1, side - 2);
+    const int cy = std::clamp(static_cast<int>((pts->y[i] - y0) / cell), 1, side - 2);
+    const std::int32_t c = cy * side + cx;
+    point_cell_[i] = c;
+    cell_min_[static_cast<std::size_t>(c)] =
+        std::min(cell_min_[static_cast<std::size_t>(c)], pts->height[i]);
+  }
+  // Overall ground level: median of the lowest return per occupied cell within 20 m of the
+  // sensor, where most cells see the road.
+  std::vector<float> near_mins;
+  const int r_cells = static_cast<int>(std::ceil(20.0 / cell));
+  const int ccx = side / 2, ccy = side / 2;
+  for (int cy = std::max(0, ccy - r_cells); cy <= std::min(side - 1, ccy + r_cells); ++cy) {
+    for (int cx = std::max(0, ccx - r_cells); cx <= std::min(side - 1, ccx + r_cells); ++cx) {
+      const float m = cell_min_[static_cast<std::size_t>(cy * side + cx)];
+      if (m < kInf) near_mins.push_back(m);
+    }
+  }
+  float level = static_cast<float>(params_.ground_height_body);
+  if (!near_mins.empty()) {
+    auto mid = near_mins.begin() + static_cast<std::ptrdiff_t>(near_mins.size() / 2);
+    std::nth_element(near_mins.begin(), mid, near_mins.end());
+    level = *mid;
+  }
+  const float tol = static_cast<float>(params_.ground_tolerance);
+  std::size_t w = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::int32_t c = point_cell_[i];
+    float& g = cell_ground_[static_cast<std::size_t>(c)];
+    if (std::isnan(g)) {
+      float m = kInf;
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          m = std::min(m, cell_min_[static_cast<std::size_t>(c + dy * side + dx)]);
+        }
+      }
+      const int cx = c % side, cy = c / side;
+      const float tol_here =
+          tol + static_cast<float>(params_.ground_max_slope * cell *
+                                   std::hypot(cx - side / 2, cy - side / 2));
+      g = std::clamp(m, level - tol_here, level + tol_here);
+    }
+    const float h = pts->height[i] - g;
+    if (h < params_.min_height || h > params_.max_height) continue;
+    pts->x[w] = pts->x[i];
+    pts->y[w] = pts->y[i];
+    pts->height[w] = h;
+    pts->index[w] = pts->index[i];
+    pts->ring[w] = pts->ring[i];
+    ++w;
+  }
+  stats->ground = static_cast<std::int64_t>(n - w);
+  pts->x.resize(w);
+  pts->y.resize(w);
+  pts->height.resize(w);
+  pts->index.resize(w);
+  pts->ring.resize(w);
+}
+
+}  // namespace vtrack

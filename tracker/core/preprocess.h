@@ -1,0 +1,117 @@
+// Preprocessing of one LADAR sweep (not in the paper; DESIGN section 4, "needed all the same"):
+//
+//  1. drop returns that are not finite, closer than min_range or farther than max_range, or
+//     whose time offset lies outside the sweep;
+//  2. ego-motion compensation: every return is placed in the world frame with the ego pose
+//     interpolated at its own time utime + dt_us[i] (PoseHistory);
+//  3. for 3-D clouds (num_rings >= ground_min_rings), remove the ground and what is above the
+//     vehicles: keep returns whose height above the local ground lies in [min_height,
+//     max_height]. The local ground is either a fixed plane in the body frame ("band") or, by
+//     default, the lowest return in the 3x3 neighbourhood of a coarse world grid cell, clamped
+//     to within ground_tolerance + ground_max_slope * distance of the scan's overall ground
+//     level ("grid"), which follows slopes and any sensor mounting height without
+//     configuration. The clamp keeps a cell that sees only a roof from being taken as ground.
+//
+// Speed: the pose is looked up at "knots" every knot_us over the sweep and the world_from_sensor
+// matrix is interpolated linearly between knots per point. Against slerp at each point's own
+// time this errs by at most (omega * knot_us)^2 / 8 * range, e.g. 1 rad/s, 1 ms, 80 m: 1e-5 m
+// (tests/tracker/core/preprocess_test.cc checks it against PoseHistory::At per point).
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tracker/core/pose.h"
+#include "tracker/core/scan.h"
+
+namespace vtrack {
+
+struct PreprocessParams {
+  enum class Ground { kNone, kBand, kGrid };
+
+  double min_range = 1.0;            // [m] nearer returns are dropped (own vehicle); yaml min_range
+  double max_range = 80.0;           // [m] farther returns are dropped; yaml max_range
+  Ground ground = Ground::kGrid;      // [-] ground removal method: none | band | grid
+  int ground_min_rings = 2;          // [-] ground removal only for scans with at least this many rings
+  double ground_height_body = 0.0;   // [m] ground plane height in the body frame (band method)
+  double min_height = 0.25;          // [m] keep returns at least this far above the ground
+  double max_height = 3.0;           // [m] and at most this far
+  double ground_cell = 1.0;          // [m] grid cell size of the ground estimate (grid method)
+  double ground_tolerance = 0.6;     // [m] local ground within this of the scan's ground level,
+  double ground_max_slope = 0.05;    // [-] plus this much per metre from the sensor (slopes, pitch)
+  std::int64_t knot_us = 1000;       // [us] spacing of pose look-ups over the sweep
+  std::int64_t max_points = 500000;  // [-] larger scans are refused as "huge_scan"
+
+  // True if every field is valid; otherwise false and *error names the key and its value.
+  bool Validate(std::string* error) const;
+  std::string FirstProblem() const;  // "" if valid
+};
+
+// Returns kept after preprocessing, world frame, structure of arrays.
+struct WorldPoints {
+  std::vector<double> x, y;            // [m] world frame
+  std::vector<float> height;           // [m] above the local ground (body z for 2-D scans)
+  std::vector<std::int32_t> index;     // [-] index of the return in the scan
+  std::vector<std::int16_t> ring;      // [-]
+
+  std::size_t size() const { return x.size(); }
+  void clear();
+  void reserve(std::size_t n);
+  void push_back(double px, double py, float h, std::int32_t i, std::int16_t r);
+};
+
+struct PreprocessStats {
+  std::int64_t input = 0;         // returns in the scan
+  std::int64_t nonfinite = 0;     // NaN / Inf coordinates
+  std::int64_t bad_time = 0;      // dt_us outside [0, sweep_duration_us]
+  std::int64_t out_of_range = 0;  // nearer than min_range or farther than max_range
+  std::int64_t ground = 0;        // removed as ground or above max_height
+  std::int64_t kept = 0;
+};
+
+enum class CompensationStatus {
+  kOk,            // every knot interpolated between poses
+  kExtrapolated,  // some knot lies after the newest pose (within the allowed extrapolation)
+  kNoPose,        // no pose for part of the sweep: the scan cannot be placed in the world
+};
+
+struct PreprocessResult {
+  CompensationStatus status = CompensationStatus::kNoPose;
+  PoseHistory::LookupStatus failed_lookup = PoseHistory::LookupStatus::kOk;  // if kNoPose
+  PreprocessStats stats;
+  Eigen::Vector2d sensor_xy = Eigen::Vector2d::Zero();  // [m] sensor origin at mid-sweep, world
+  Eigen::Isometry3d world_from_body_start = Eigen::Isometry3d::Identity();
+};
+
+// Reuses its buffers from scan to scan: no allocation per point once warmed up.
+class Preprocessor {
+ public:
+  explicit Preprocessor(const PreprocessParams& params);
+
+  // Fills *out (cleared first). max_extrapolation_us: how far past the newest pose a return's
+  // time may lie. With no pose for part of the sweep, status is kNoPose and *out is empty.
+  // (The size limit max_points is enforced by the caller, Tracker, before any work.)
+  PreprocessResult Run(const LadarScan& scan, const PoseHistory& poses,
+                       std::int64_t max_extrapolation_us, WorldPoints* out);
+
+  const PreprocessParams& params() const { return params_; }
+
+ private:
+  void RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts, PreprocessStats* stats);
+
+  PreprocessParams params_;
+  // Knots: world_from_sensor rows x and y (3x4 each, as 2x4) and their differences.
+  std::vector<Eigen::Matrix<double, 2, 4>> knot_m_, knot_d_;
+  // Ground grid.
+  std::vector<float> cell_min_, cell_ground_;
+  std::vector<std::int32_t> point_cell_;
+  std::vector<float> body_z_;
+};
+
+const char* ToString(PreprocessParams::Ground g);
+bool ParseGround(const std::string& s, PreprocessParams::Ground* g);
+
+}  // namespace vtrack

@@ -1,0 +1,80 @@
+// Segmentation of the preprocessed returns into objects (not in the paper; DESIGN section 4).
+//
+// - Single-plane scans (num_rings == 1): returns are in scan order; a new segment starts where
+//   two consecutive returns lie farther apart than max(jump_abs, jump_rel * range) (a range
+//   jump). A full 360 deg sweep wraps: the last and first returns may belong to one segment.
+// - 3-D clouds: returns are binned in a world-aligned grid around the sensor (cell_size) and
+//   occupied cells are joined into connected components (8- or 4-neighbourhood). Cells are
+//   stamped with a scan counter, so the grid is never cleared: the cost is linear in the returns.
+//
+// Segments with fewer than min_points returns or wider than max_extent are dropped (walls and
+// buildings are not objects to track).
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tracker/core/preprocess.h"
+
+namespace vtrack {
+
+struct SegmentationParams {
+  double jump_abs = 0.6;      // [m] scan line: minimum break distance between consecutive returns
+  double jump_rel = 0.02;     // [-] scan line: break distance per metre of range
+  double cell_size = 0.35;    // [m] grid cell size for 3-D clouds
+  int connectivity = 8;       // [-] grid neighbourhood: 4 or 8
+  double grid_radius = 80.0;  // [m] half-size of the grid around the sensor (returns beyond: dropped)
+  int min_points = 3;         // [-] smaller segments are dropped
+  double max_extent = 25.0;   // [m] segments whose bounding-box diagonal is larger are dropped
+
+  // True if every field is valid; otherwise false and *error names the key and its value.
+  bool Validate(std::string* error) const;
+  std::string FirstProblem() const;  // "" if valid
+};
+
+struct Segment {
+  std::int32_t begin = 0;  // [-] range [begin, end) in Segments::point
+  std::int32_t end = 0;
+  Eigen::Vector2d min = Eigen::Vector2d::Zero();  // [m] world bounding box
+  Eigen::Vector2d max = Eigen::Vector2d::Zero();
+  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();  // [m]
+  std::int32_t size() const { return end - begin; }
+};
+
+struct Segments {
+  std::vector<std::int32_t> point;  // indices into WorldPoints, grouped by segment
+  std::vector<Segment> segments;
+  std::int64_t dropped_small = 0;   // segments dropped for too few points
+  std::int64_t dropped_large = 0;   // segments dropped for too large an extent
+  void clear();
+};
+
+class Segmenter {
+ public:
+  explicit Segmenter(const SegmentationParams& params);
+
+  // scan_line: true for single-plane scans (num_rings == 1). sensor_xy: the sensor origin in the
+  // world frame (range of a return for the jump threshold; centre of the grid).
+  void Run(const WorldPoints& pts, bool scan_line, const Eigen::Vector2d& sensor_xy,
+           Segments* out);
+
+ private:
+  void RunScanLine(const WorldPoints& pts, const Eigen::Vector2d& sensor_xy, Segments* out);
+  void RunGrid(const WorldPoints& pts, const Eigen::Vector2d& sensor_xy, Segments* out);
+  // Appends a segment from out->point[begin, end) if it passes the size filters.
+  void Finish(const WorldPoints& pts, std::int32_t begin, Segments* out);
+
+  SegmentationParams params_;
+  int side_ = 0;
+  std::uint32_t generation_ = 0;
+  std::vector<std::uint32_t> cell_stamp_;  // == generation_ if occupied in this scan
+  std::vector<std::int32_t> cell_slot_;    // index into occupied_ for occupied cells
+  std::vector<std::int32_t> occupied_;     // cell ids
+  std::vector<std::int32_t> slot_count_, slot_start_, slot_label_;
+  std::vector<std::int32_t> point_cell_, sorted_, stack_;
+};
+
+}  // namespace vtrack

@@ -16,7 +16,9 @@ if(VTRACK_BUILD_JAVA)
   install(FILES ${VTRACK_JAR} DESTINATION ${CMAKE_INSTALL_DATADIR}/java)
 endif()
 install(PROGRAMS ${PROJECT_SOURCE_DIR}/scripts/vtrack-netns DESTINATION ${CMAKE_INSTALL_BINDIR})
-install(DIRECTORY ${PROJECT_SOURCE_DIR}/config/ DESTINATION ${CMAKE_INSTALL_DATADIR}/vtrack/config)
+if(EXISTS ${PROJECT_SOURCE_DIR}/config)
+  install(DIRECTORY ${PROJECT_SOURCE_DIR}/config/ DESTINATION ${CMAKE_INSTALL_DATADIR}/vtrack/config)
+endif()
 
 install(EXPORT vtrackTargets NAMESPACE vtrack:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/vtrack)
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/vtrackConfig.cmake.in

@@ -4,6 +4,7 @@
 #   ./vtrack.sh demo [DEMO OPTIONS]   the main job (see ./vtrack.sh demo --help)
 #   ./vtrack.sh test [CTEST ARGS]     every test (what CI runs)
 #   ./vtrack.sh bench [--json F]      the benchmarks
+#   ./vtrack.sh fuzz [SECONDS]        build the libFuzzer harnesses (clang) and run each SECONDS (60)
 #   ./vtrack.sh build                 set up and build only
 #   ./vtrack.sh deps                  install the Debian packages only
 #
@@ -23,8 +24,9 @@ pkgs_build=(g++ make cmake pkg-config
 pkgs_run=(iproute2 procps zstd tar)
 pkgs_test=(xvfb xauth default-jre libjchart2d-java)
 pkgs_bench=()
+pkgs_fuzz=(clang libclang-rt-14-dev)
 
-usage() { sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; }
 
 log() { printf '\033[1m[vtrack]\033[0m %s\n' "$*" >&2; }
 
@@ -88,6 +90,9 @@ case "$cmd" in
       "$b" "$@"
     done
     [ $found = 1 ] || log "no benchmark programs are built yet" ;;
+  fuzz)
+    install_packages "${pkgs_build[@]}" "${pkgs_fuzz[@]}"
+    exec "$here/scripts/fuzz.sh" "$here" "${1:-60}" ;;
   demo)
     install_packages "${pkgs_build[@]}" "${pkgs_run[@]}"
     configure_and_build Release

@@ -1,5 +1,6 @@
 #include "lcmtypes/util/decode.h"
 
+#include <cstring>
 #include <string>
 
 #include "vtrack/hypothesis_t.hpp"
@@ -69,7 +70,15 @@ class Walker {
   bool SkipString(const char* field) {
     std::int32_t len = 0;
     if (!ReadI32(&len, field)) return false;
-    if (len < 0) return Fail(field, "negative string length");
+    // LCM strings carry their NUL terminator inside the length; LCM's decoder does not check
+    // it and would accept (and re-encode differently) a string without one.
+    if (len < 1) return Fail(field, "string length " + std::to_string(len) + " < 1");
+    if (static_cast<std::size_t>(len) > remaining()) return Fail(field, "truncated string");
+    if (p_[pos_ + static_cast<std::size_t>(len) - 1] != 0) return Fail(field, "string not NUL-terminated");
+    // LCM's encoder measures strings with strlen: an embedded NUL would not survive a round trip.
+    if (std::memchr(p_ + pos_, 0, static_cast<std::size_t>(len) - 1) != nullptr) {
+      return Fail(field, "string contains a NUL byte");
+    }
     return Skip(static_cast<std::size_t>(len), field);
   }
   // Reads an array length field and checks that count elements of at least min_elem_bytes each

@@ -203,3 +203,34 @@ TEST(LcmTypes, CorruptedBuffersNeverCrash) {
 
 }  // namespace
 }  // namespace vtrack
+
+namespace vtrack {
+namespace {
+
+// LCM's decoder accepts a string whose bytes lack the NUL terminator or hold an embedded NUL;
+// its encoder then writes different bytes (it uses strlen). Decode<T> refuses both (found by the
+// decoder fuzzers; inputs kept in tests/fuzz/regressions/).
+TEST(LcmTypes, MalformedStringsAreRefused) {
+  testing::RandomMessages r(13);
+  ladar_scan_t m = r.Scan(3);
+  m.sensor_id = "abcd";
+  auto bytes = testing::Encode(m);
+  // sensor_id: int32 length (5) at offset 8 (hash) + 16 (utime, seq), then "abcd\0".
+  const size_t at = 8 + 16 + 4;
+  ASSERT_EQ(bytes[at - 1], 5);
+  ASSERT_EQ(bytes[at + 4], 0);
+  ladar_scan_t out;
+  std::string why;
+  auto no_nul = bytes;
+  no_nul[at + 4] = 'e';
+  EXPECT_EQ(lcm_util::Decode(no_nul.data(), no_nul.size(), &out, &why), lcm_util::DecodeError::kBadLength);
+  EXPECT_NE(why.find("NUL-terminated"), std::string::npos) << why;
+  auto embedded = bytes;
+  embedded[at + 1] = 0;
+  EXPECT_EQ(lcm_util::Decode(embedded.data(), embedded.size(), &out, &why), lcm_util::DecodeError::kBadLength);
+  EXPECT_NE(why.find("contains a NUL"), std::string::npos) << why;
+  EXPECT_EQ(lcm_util::Decode(bytes.data(), bytes.size(), &out), lcm_util::DecodeError::kNone);
+}
+
+}  // namespace
+}  // namespace vtrack

@@ -1,0 +1,138 @@
+#include "log_tools/eval/cli_common.h"
+
+#include <cstdio>
+#include <sstream>
+#include <stdexcept>
+
+#include "sensor_driver/kitti/kitti_io.h"
+
+namespace po = boost::program_options;
+
+namespace vtrack::eval {
+
+void AddEvalOptions(po::options_description* desc, EvalCliOptions* o) {
+  desc->add_options()
+    ("mode", po::value(&o->mode), "tracker mode whose TRACKS to score (ism, vasm, mht); "
+                                  "default: the only one in the logs")
+    ("gate", po::value(&o->gate_m)->default_value(o->gate_m),
+     "[m] CLEAR MOT match gate on the centre distance")
+    ("hota-gate", po::value(&o->hota_gate_m)->default_value(o->hota_gate_m),
+     "[m] HOTA similarity S = max(0, 1 - d / hota-gate)")
+    ("score-coasting", po::bool_switch(&o->score_coasting),
+     "also score coasting tracks (default: confirmed tracks only)")
+    ("region-range", po::value(&o->region_range_m)->default_value(o->region_range_m),
+     "[m] score only within this distance of the ego vehicle (0 = no limit)")
+    ("region-fov", po::value(&o->region_fov_deg)->default_value(o->region_fov_deg),
+     "[deg] score only within this full angle about the ego vehicle's heading (360 = all)")
+    ("region-camera", po::bool_switch(&o->region_camera),
+     "score only inside camera 2's horizontal view (needs --kitti-calib): KITTI's labelled region")
+    ("horizons", po::value(&o->horizons)->default_value(o->horizons),
+     "[s] prediction horizons, comma separated")
+    ("truth-channel", po::value(&o->truth_channel)->default_value(o->truth_channel), "ground truth channel")
+    ("tracks-channel", po::value(&o->tracks_channel)->default_value(o->tracks_channel), "tracks channel")
+    ("pose-channel", po::value(&o->pose_channel)->default_value(o->pose_channel), "ego pose channel")
+    ("scan-channel", po::value(&o->scan_channel)->default_value(o->scan_channel),
+     "LADAR scan channel (read for the sensor mounting)")
+    ("kitti-calib", po::value(&o->kitti_calib), "KITTI calibration file (calib/NNNN.txt) for "
+                                                "--region-camera and --kitti-out")
+    ("kitti-image-size", po::value(&o->kitti_image_size)->default_value(o->kitti_image_size),
+     "[px] camera 2 image size WxH")
+    ("kitti-sensor-height", po::value(&o->kitti_sensor_height_m)->default_value(o->kitti_sensor_height_m),
+     "[m] LADAR height above the road (bottom of exported boxes)")
+    ("kitti-box-height", po::value(&o->kitti_box_height_m)->default_value(o->kitti_box_height_m, "1.6"),
+     "[m] box height written for every exported track")
+    ("kitti-time-offset", po::value(&o->kitti_time_offset_s)->default_value(o->kitti_time_offset_s),
+     "[s] advance of exported states (scan time -> label time); < 0 = half the sweep duration");
+}
+
+std::vector<double> ParseDoubleList(const std::string& option, const std::string& text) {
+  std::vector<double> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size()) {
+      throw std::invalid_argument("--" + option + ": '" + item + "' is not a number (in '" + text + "')");
+    }
+    out.push_back(v);
+  }
+  if (out.empty()) throw std::invalid_argument("--" + option + ": empty list");
+  return out;
+}
+
+namespace {
+
+std::pair<int, int> ParseImageSize(const std::string& text) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' || w <= 0 || h <= 0) {
+    throw std::invalid_argument("--kitti-image-size: expected WxH with positive integers, got '" +
+                                text + "'");
+  }
+  return {w, h};
+}
+
+kitti::Calibration ReadCalib(const std::string& path) {
+  try {
+    return kitti::ReadCalibration(path);
+  } catch (const kitti::KittiError& e) {
+    throw std::invalid_argument(std::string("--kitti-calib: ") + e.what());
+  }
+}
+
+}  // namespace
+
+EvalParams MakeEvalParams(const EvalCliOptions& o) {
+  EvalParams p;
+  p.mode = o.mode;
+  p.gate_m = o.gate_m;
+  p.hota_gate_m = o.hota_gate_m;
+  p.score_coasting = o.score_coasting;
+  p.region_range_m = o.region_range_m;
+  p.region_fov_deg = o.region_fov_deg;
+  p.horizons_s = ParseDoubleList("horizons", o.horizons);
+  p.truth_channel = o.truth_channel;
+  p.tracks_channel = o.tracks_channel;
+  p.pose_channel = o.pose_channel;
+  p.scan_channel = o.scan_channel;
+  if (o.region_camera) {
+    if (o.kitti_calib.empty()) {
+      throw std::invalid_argument("--region-camera needs --kitti-calib FILE");
+    }
+    const kitti::Calibration calib = ReadCalib(o.kitti_calib);
+    CameraRegion cam;
+    cam.rect_from_sensor = calib.RectFromVelo();
+    cam.P = *calib.P[2];
+    cam.width = ParseImageSize(o.kitti_image_size).first;
+    p.region_camera = cam;
+  }
+  if (const std::string err = p.Validate(); !err.empty()) {
+    throw std::invalid_argument("bad evaluation option: " + err);
+  }
+  return p;
+}
+
+std::optional<KittiExportParams> MakeKittiExportParams(const EvalCliOptions& o) {
+  if (o.kitti_calib.empty()) return std::nullopt;
+  const kitti::Calibration calib = ReadCalib(o.kitti_calib);
+  KittiExportParams k;
+  k.rect_from_sensor = calib.RectFromVelo();
+  k.P2 = *calib.P[2];
+  std::tie(k.image_width, k.image_height) = ParseImageSize(o.kitti_image_size);
+  k.sensor_height_m = o.kitti_sensor_height_m;
+  k.box_height_m = o.kitti_box_height_m;
+  k.time_offset_s = o.kitti_time_offset_s;
+  k.score_coasting = o.score_coasting;
+  if (const std::string err = k.Validate(); !err.empty()) {
+    throw std::invalid_argument("bad KITTI export option: " + err);
+  }
+  return k;
+}
+
+}  // namespace vtrack::eval

@@ -1,0 +1,338 @@
+#include "log_tools/eval/compare.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstring>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "lcmtypes/util/process.h"
+#include "log_tools/eval/json_writer.h"
+#include "log_tools/eval/progress.h"
+#include "log_tools/eval/report.h"
+#include "sensor_driver/kitti/kitti_layout.h"
+
+extern char** environ;
+
+namespace vtrack::eval {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string Join(const std::vector<std::string>& argv) {
+  std::string s;
+  for (const auto& a : argv) s += (s.empty() ? "" : " ") + a;
+  return s;
+}
+
+// Last lines of a child's log, for the error message.
+std::string Tail(const std::string& path, int lines) {
+  std::ifstream in(path);
+  std::vector<std::string> all;
+  for (std::string l; std::getline(in, l);) all.push_back(l);
+  std::string out;
+  for (std::size_t i = all.size() > static_cast<std::size_t>(lines) ? all.size() - lines : 0;
+       i < all.size(); ++i) {
+    out += "    " + all[i] + "\n";
+  }
+  return out;
+}
+
+// Runs argv to completion with stdout and stderr in log_path. Throws std::runtime_error with the
+// command, the reason and the end of its output if it cannot start, fails, or times out.
+void RunProcess(const std::vector<std::string>& argv, const std::string& log_path, double timeout_s) {
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_path.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  std::vector<char*> args;
+  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, args[0], &actions, nullptr, args.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) {
+    throw std::runtime_error("cannot start '" + argv[0] + "': " + std::strerror(rc));
+  }
+  const auto start = std::chrono::steady_clock::now();
+  int status = 0;
+  std::string failure;
+  while (true) {
+    const pid_t r = waitpid(pid, &status, WNOHANG);
+    if (r == pid) break;
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (lcm_util::StopRequested() || elapsed > timeout_s) {
+      failure = lcm_util::StopRequested() ? "interrupted" : "timed out after " + std::to_string(timeout_s) + " s";
+      kill(pid, SIGTERM);
+      for (int i = 0; i < 50 && waitpid(pid, &status, WNOHANG) != pid; ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        if (i == 49) {
+          kill(pid, SIGKILL);
+          waitpid(pid, &status, 0);
+        }
+      }
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  if (failure.empty()) {
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return;
+    failure = WIFEXITED(status) ? "exit status " + std::to_string(WEXITSTATUS(status))
+                                : "killed by signal " + std::to_string(WTERMSIG(status));
+  }
+  throw std::runtime_error("'" + Join(argv) + "' failed (" + failure + "); its output (" + log_path +
+                           ") ends:\n" + Tail(log_path, 15));
+}
+
+std::string DefaultBinDir() {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string(".") : self.parent_path().string();
+}
+
+std::string FindKittiCalib(const CompareOptions& o, const CompareItem& item) {
+  if (!o.kitti_calib.empty()) return o.kitti_calib;
+  const std::string seq = kitti::NormaliseSequence(o.kitti_sequence);
+  for (const fs::path& p : {fs::path(item.source) / "calib" / (seq + ".txt"),
+                            fs::path(item.source) / "training" / "calib" / (seq + ".txt")}) {
+    if (fs::is_regular_file(p)) return p.string();
+  }
+  throw std::runtime_error("no calibration calib/" + seq + ".txt under '" + item.source +
+                           "' (needed to score KITTI inside the camera view): pass --kitti-calib");
+}
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+}  // namespace
+
+CompareItem ScenarioItem(const std::string& name_or_path) {
+  CompareItem item;
+  item.kind = CompareItem::Kind::kScenario;
+  item.source = name_or_path;
+  item.name = fs::path(name_or_path).stem().string();
+  if (item.name.empty()) throw std::invalid_argument("empty scenario name in --scenarios");
+  return item;
+}
+
+int RunCompare(const CompareOptions& o) {
+  if (o.items.empty()) throw std::invalid_argument("nothing to compare: give --scenarios and/or --kitti");
+  if (o.modes.empty()) throw std::invalid_argument("--modes is empty");
+  for (const auto& m : o.modes) {
+    if (m != "ism" && m != "vasm" && m != "mht") {
+      throw std::invalid_argument("--modes: unknown mode '" + m + "' (ism, vasm, mht)");
+    }
+  }
+  if (!(o.timeout_s > 0.0)) {
+    throw std::invalid_argument("--timeout must be > 0, got " + std::to_string(o.timeout_s));
+  }
+  if (!(o.kitti_range_m > 0.0)) {
+    throw std::invalid_argument("--kitti-range must be > 0, got " + std::to_string(o.kitti_range_m));
+  }
+  std::map<std::string, int> names;
+  for (const auto& item : o.items) {
+    if (++names[item.name] > 1) {
+      throw std::invalid_argument("two items are named '" + item.name + "'; rename a scenario file");
+    }
+  }
+  const EvalParams scenario_params = MakeEvalParams(o.eval);  // validates the eval options
+  const std::string bin_dir = o.bin_dir.empty() ? DefaultBinDir() : o.bin_dir;
+  auto tool = [&](const std::string& name) {
+    const fs::path p = fs::path(bin_dir) / name;
+    if (!fs::exists(p)) {
+      throw std::runtime_error("'" + p.string() + "' does not exist (build it, or pass --bin-dir)");
+    }
+    return p.string();
+  };
+
+  // Work directory.
+  std::string work = o.work_dir;
+  bool temporary = false;
+  if (work.empty()) {
+    std::string tmpl = (fs::temp_directory_path() / "vtrack-compare-XXXXXX").string();
+    if (!mkdtemp(tmpl.data())) throw std::runtime_error("cannot create a temporary directory");
+    work = tmpl;
+    temporary = true;
+  } else {
+    std::error_code ec;
+    fs::create_directories(work, ec);
+    if (!fs::is_directory(work)) throw std::runtime_error("cannot create --work-dir '" + work + "'");
+  }
+  if (!o.plots_dir.empty()) {
+    std::error_code ec;
+    fs::create_directories(o.plots_dir, ec);
+    if (!fs::is_directory(o.plots_dir)) {
+      throw std::runtime_error("cannot create --plots directory '" + o.plots_dir + "'");
+    }
+  }
+
+  lcm_util::InstallStopHandlers();
+  const int total = static_cast<int>(o.items.size() * (1 + o.modes.size()));
+  int step = 0;
+  auto say = [&](const std::string& what) {
+    if (!o.quiet) std::fprintf(stderr, "[%d/%d] %s\n", step, total, what.c_str());
+  };
+
+  // results[item][mode]; an item or mode that failed has no entry.
+  std::map<std::string, std::map<std::string, EvalSummary>> results;
+  std::vector<std::string> failures;
+  for (const CompareItem& item : o.items) {
+    if (lcm_util::StopRequested()) break;
+    const fs::path dir = fs::path(work) / item.name;
+    fs::create_directories(dir);
+    const std::string run = (dir / "run.lcm").string();
+    EvalParams params = scenario_params;
+    ++step;
+    try {
+      std::vector<std::string> argv;
+      if (item.kind == CompareItem::Kind::kScenario) {
+        argv = {tool("vtrack-sim-log"), "--scenario", item.source, "--out", run, "--seed",
+                std::to_string(o.seed)};
+      } else {
+        argv = {tool("vtrack-kitti2lcm"), "--kitti", item.source, "--sequence", o.kitti_sequence,
+                "--out", run};
+        if (!o.kitti_poses.empty()) argv.insert(argv.end(), {"--poses", o.kitti_poses});
+        if (!o.kitti_oxts.empty()) argv.insert(argv.end(), {"--oxts", o.kitti_oxts});
+        EvalCliOptions kopt = o.eval;
+        kopt.kitti_calib = FindKittiCalib(o, item);
+        kopt.region_camera = true;
+        kopt.region_range_m = o.kitti_range_m;
+        params = MakeEvalParams(kopt);
+      }
+      if (o.reuse && fs::is_regular_file(run)) {
+        say(item.name + ": reusing " + run);
+      } else {
+        say(item.name + ": " + Join(argv));
+        const auto t = std::chrono::steady_clock::now();
+        RunProcess(argv, (dir / "run.log").string(), o.timeout_s);
+        say(item.name + ": log written in " + std::to_string(static_cast<int>(Seconds(t))) + " s");
+      }
+    } catch (const std::exception& e) {
+      failures.push_back(item.name + ": " + e.what());
+      std::fprintf(stderr, "vtrack-compare: %s: %s\n", item.name.c_str(), e.what());
+      step += static_cast<int>(o.modes.size());
+      continue;
+    }
+
+    // Ground truth and poses once; each mode's tracks added to a copy.
+    LogData base;
+    try {
+      Progress progress(!o.quiet);
+      base = LoadLogs({run}, params, [&](const std::string&, double f) {
+        progress.Update("reading " + item.name + "/run.lcm", f);
+      });
+    } catch (const std::exception& e) {
+      failures.push_back(item.name + ": " + e.what());
+      std::fprintf(stderr, "vtrack-compare: %s: %s\n", item.name.c_str(), e.what());
+      step += static_cast<int>(o.modes.size());
+      continue;
+    }
+    for (const std::string& mode : o.modes) {
+      if (lcm_util::StopRequested()) break;
+      ++step;
+      const std::string tracks = (dir / ("tracks_" + mode + ".lcm")).string();
+      try {
+        if (o.reuse && fs::is_regular_file(tracks)) {
+          say(item.name + " / " + mode + ": reusing " + tracks);
+        } else {
+          std::vector<std::string> argv = {tool("vtrack-tracker"), "--input", run, "--output",
+                                           tracks, "--mode", mode};
+          if (!o.tracker_config.empty()) argv.insert(argv.end(), {"--config", o.tracker_config});
+          say(item.name + " / " + mode + ": " + Join(argv));
+          const auto t = std::chrono::steady_clock::now();
+          RunProcess(argv, (dir / ("tracker_" + mode + ".log")).string(), o.timeout_s);
+          say(item.name + " / " + mode + ": tracked in " +
+              std::to_string(static_cast<int>(Seconds(t))) + " s");
+        }
+        LogData data = base;
+        AddLog(&data, tracks, params);
+        EvalParams p = params;
+        p.mode = mode;
+        results[item.name][mode] = Evaluate(data, p);
+      } catch (const std::exception& e) {
+        failures.push_back(item.name + " / " + mode + ": " + e.what());
+        std::fprintf(stderr, "vtrack-compare: %s / %s: %s\n", item.name.c_str(), mode.c_str(),
+                     e.what());
+      }
+    }
+    if (!o.plots_dir.empty() && results.count(item.name)) {
+      const std::string path = (fs::path(o.plots_dir) / (item.name + "_modes.png")).string();
+      try {
+        WriteModePlot("vtrack-compare: " + item.name + " (ism, vasm, mht)", results[item.name], path);
+        say(item.name + ": wrote " + path);
+      } catch (const std::exception& e) {
+        failures.push_back(item.name + ": " + e.what());
+      }
+    }
+  }
+
+  // The table, in the order given.
+  std::vector<TableRow> rows;
+  for (const CompareItem& item : o.items) {
+    for (const std::string& mode : o.modes) {
+      const auto it = results.find(item.name);
+      const EvalSummary* s = nullptr;
+      if (it != results.end() && it->second.count(mode)) s = &it->second.at(mode);
+      rows.push_back({item.name, mode, s});
+    }
+  }
+  std::cout << ComparisonTable(rows) << std::flush;
+
+  if (!o.json_path.empty()) {
+    JsonWriter w;
+    w.BeginObject();
+    for (const CompareItem& item : o.items) {
+      w.Key(item.name).BeginObject();
+      for (const std::string& mode : o.modes) {
+        const auto it = results.find(item.name);
+        w.Key(mode);
+        if (it != results.end() && it->second.count(mode)) {
+          std::string js = SummaryJson(it->second.at(mode));
+          while (!js.empty() && js.back() == '\n') js.pop_back();
+          w.Raw(js);
+        } else {
+          w.Raw("null");
+        }
+      }
+      w.EndObject();
+    }
+    w.EndObject();
+    WriteTextFile(o.json_path, w.str() + "\n");
+    std::fprintf(stderr, "wrote %s\n", o.json_path.c_str());
+  }
+
+  if (temporary) {
+    if (o.keep_work || !failures.empty()) {
+      std::fprintf(stderr, "work directory kept: %s\n", work.c_str());
+    } else {
+      std::error_code ec;
+      fs::remove_all(work, ec);
+    }
+  }
+  if (lcm_util::StopRequested()) failures.push_back("interrupted");
+  if (!failures.empty()) {
+    std::fprintf(stderr, "vtrack-compare: %zu failure(s):\n", failures.size());
+    for (const auto& f : failures) std::fprintf(stderr, "  %s\n", f.c_str());
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace vtrack::eval

@@ -1,0 +1,52 @@
+// vtrack-compare: the tracker's three modes side by side on scenarios and real data.
+//
+// For each item, a log with scans, ego pose and ground truth is made once:
+//   scenario NAME: vtrack-sim-log --scenario NAME --out <work>/<item>/run.lcm --seed N
+//   KITTI DIR:     vtrack-kitti2lcm --kitti DIR --sequence S --out <work>/<item>/run.lcm [--poses F | --oxts F]
+// then for each mode M:  vtrack-tracker --input run.lcm --output tracks_M.lcm --mode M [--config F]
+// and the tracks are scored with vtrack_eval (a library call, the same code as vtrack-eval).
+// KITTI items are scored inside camera 2's view (its labelled region) within kitti_range_m.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "log_tools/eval/cli_common.h"
+
+namespace vtrack::eval {
+
+struct CompareItem {
+  enum class Kind { kScenario, kKitti };
+  Kind kind = Kind::kScenario;
+  std::string name;    // [-] key in the table and the JSON: scenario name, or kitti_<sequence>
+  std::string source;  // [-] scenario NAME or path; KITTI directory
+};
+
+struct CompareOptions {
+  std::vector<CompareItem> items;
+  std::vector<std::string> modes = {"ism", "vasm", "mht"};
+  std::int64_t seed = 1;              // [-] simulator seed
+  std::string json_path;              // [-] "" = no JSON
+  std::string plots_dir;              // [-] "" = no plots
+  std::string work_dir;               // [-] "" = a fresh temporary directory, removed at the end
+  bool keep_work = false;             // [-] keep the temporary directory
+  bool reuse = false;                 // [-] reuse run.lcm / tracks_M.lcm already in work_dir
+  std::string tracker_config;         // [-] passed to vtrack-tracker --config
+  std::string bin_dir;                // [-] where the vtrack executables are
+  double timeout_s = 3600.0;          // [s] per child process; > 0
+  std::string kitti_sequence = "0000";
+  std::string kitti_poses, kitti_oxts, kitti_calib;  // [-] "" = the converter's / DIR's default
+  double kitti_range_m = 40.0;        // [m] KITTI scoring range; > 0
+  EvalCliOptions eval;                // scoring options for the scenarios
+  bool quiet = false;
+};
+
+// Scenario item from a NAME or path ("urban_intersection", "config/scenarios/x.yaml").
+CompareItem ScenarioItem(const std::string& name_or_path);
+
+// Runs everything, prints progress to stderr and the table to stdout. Returns the exit status:
+// 0 if every (item, mode) was scored, 1 otherwise. Throws std::invalid_argument for bad options.
+int RunCompare(const CompareOptions& options);
+
+}  // namespace vtrack::eval

@@ -1,0 +1,576 @@
+#include "log_tools/eval/evaluator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+#include <Eigen/Cholesky>
+
+#include "lcmtypes/util/decode.h"
+#include "lcmtypes/util/log_reader.h"
+#include "log_tools/eval/gated_assignment.h"
+#include "tracker/core/angle.h"
+#include "vtrack/ladar_scan_t.hpp"
+#include "vtrack/pose_t.hpp"
+
+namespace vtrack::eval {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+bool IsVehicleClass(std::int8_t c) {
+  return c == vtrack::object_t::CLASS_CAR || c == vtrack::object_t::CLASS_VAN ||
+         c == vtrack::object_t::CLASS_TRUCK || c == vtrack::object_t::CLASS_SKID_STEER;
+}
+
+std::string Encode(const auto& msg) {
+  std::string buf(static_cast<std::size_t>(msg.getEncodedSize()), '\0');
+  msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  return buf;
+}
+
+// Stores msg under utime; an identical copy (the same log given twice, or a recording that
+// holds the tracker's output too) is skipped, a different one is an error.
+template <class Msg>
+void Insert(std::map<std::int64_t, Msg>* by_time, const Msg& msg, const std::string& key,
+            const std::string& what, const std::string& path,
+            std::map<std::string, std::int64_t>* problems) {
+  auto [it, inserted] = by_time->emplace(msg.utime, msg);
+  if (inserted) return;
+  if (Encode(it->second) == Encode(msg)) {
+    ++(*problems)["duplicate_identical_" + key];
+    return;
+  }
+  std::ostringstream os;
+  os << path << ": two different " << what << " messages for utime " << msg.utime
+     << " (tracks of two runs of one mode, or two sources of ground truth?); pass the logs of"
+        " one run";
+  throw std::runtime_error(os.str());
+}
+
+std::optional<Eigen::Isometry3d> PoseFromMessage(const vtrack::pose_t& p) {
+  Eigen::Quaterniond q(p.orientation[0], p.orientation[1], p.orientation[2], p.orientation[3]);
+  const Eigen::Vector3d t(p.pos[0], p.pos[1], p.pos[2]);
+  if (!t.allFinite() || !q.coeffs().allFinite() || q.norm() < 1e-6) return std::nullopt;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = q.normalized().toRotationMatrix();
+  pose.translation() = t;
+  return pose;
+}
+
+struct Stats {  // running root-mean-square / mean
+  double sum = 0.0, sum_sq = 0.0;
+  std::int64_t n = 0;
+  void Add(double v) {
+    if (!std::isfinite(v)) return;
+    sum += v;
+    sum_sq += v * v;
+    ++n;
+  }
+  double Rms() const { return n > 0 ? std::sqrt(sum_sq / static_cast<double>(n)) : kNaN; }
+  double Mean() const { return n > 0 ? sum / static_cast<double>(n) : kNaN; }
+};
+
+// Linear interpolation of (pred_x, pred_y) at pred time h [s]; nullopt outside the prediction.
+std::optional<Eigen::Vector2d> PredictedAt(const vtrack::track_t& tr, double h) {
+  const int n = std::min<int>(tr.npred, static_cast<int>(tr.pred_t.size()));
+  if (n <= 0) return std::nullopt;
+  constexpr double kTol = 1e-3;  // [s] float pred_t against a horizon such as 1.0
+  if (h < tr.pred_t[0] - kTol || h > tr.pred_t[n - 1] + kTol) return std::nullopt;
+  if (n == 1) return Eigen::Vector2d(tr.pred_x[0], tr.pred_y[0]);
+  int k = 0;
+  while (k + 2 < n && tr.pred_t[k + 1] < h) ++k;
+  const double t0 = tr.pred_t[k], t1 = tr.pred_t[k + 1];
+  const double s = t1 > t0 ? std::clamp((h - t0) / (t1 - t0), 0.0, 1.0) : 0.0;
+  Eigen::Vector2d p((1 - s) * tr.pred_x[k] + s * tr.pred_x[k + 1],
+                    (1 - s) * tr.pred_y[k] + s * tr.pred_y[k + 1]);
+  if (!p.allFinite()) return std::nullopt;
+  return p;
+}
+
+const vtrack::object_t* FindObject(const vtrack::object_list_t& list, std::int64_t id) {
+  for (const auto& o : list.objects) {
+    if (o.id == id) return &o;
+  }
+  return nullptr;
+}
+
+// Position of truth object id at utime, interpolated between the ground-truth scans around it.
+std::optional<Eigen::Vector2d> TruthAt(const std::map<std::int64_t, vtrack::object_list_t>& truth,
+                                       std::int64_t id, std::int64_t utime, double max_gap_s) {
+  auto hi = truth.lower_bound(utime);
+  if (hi == truth.end()) return std::nullopt;  // beyond the log
+  const vtrack::object_t* b = FindObject(hi->second, id);
+  if (hi->first == utime) {
+    if (!b) return std::nullopt;
+    return Eigen::Vector2d(b->x, b->y);
+  }
+  if (hi == truth.begin() || !b) return std::nullopt;
+  auto lo = std::prev(hi);
+  const vtrack::object_t* a = FindObject(lo->second, id);
+  if (!a) return std::nullopt;
+  const double gap = static_cast<double>(hi->first - lo->first) * 1e-6;
+  if (gap > max_gap_s) return std::nullopt;
+  const double s = static_cast<double>(utime - lo->first) / static_cast<double>(hi->first - lo->first);
+  return Eigen::Vector2d((1 - s) * a->x + s * b->x, (1 - s) * a->y + s * b->y);
+}
+
+}  // namespace
+
+bool CameraRegion::Contains(const Eigen::Vector3d& p_sensor) const {
+  const Eigen::Vector3d rect = rect_from_sensor * p_sensor;
+  const Eigen::Vector3d img = P * rect.homogeneous();
+  if (!(rect.z() > 0.1) || !(img.z() > 0.0)) return false;  // behind or at the camera
+  const double u = img.x() / img.z();
+  return u >= 0.0 && u < static_cast<double>(width);
+}
+
+std::string EvalParams::Validate() const {
+  std::ostringstream os;
+  auto positive = [&](const char* key, double v) {
+    if (os.tellp() == 0 && !(v > 0.0 && std::isfinite(v))) os << key << " must be > 0, got " << v;
+  };
+  if (truth_channel.empty() || tracks_channel.empty()) {
+    os << "truth_channel and tracks_channel must not be empty";
+  }
+  positive("gate_m", gate_m);
+  positive("hota_gate_m", hota_gate_m);
+  positive("max_truth_gap_s", max_truth_gap_s);
+  positive("max_pose_gap_s", max_pose_gap_s);
+  if (os.tellp() == 0 && !(region_range_m >= 0.0 && std::isfinite(region_range_m))) {
+    os << "region_range_m must be >= 0 (0 = no limit), got " << region_range_m;
+  }
+  if (os.tellp() == 0 && !(region_fov_deg > 0.0 && region_fov_deg <= 360.0)) {
+    os << "region_fov_deg must be in (0, 360], got " << region_fov_deg;
+  }
+  if (os.tellp() == 0 && !(moving_speed_mps >= 0.0 && std::isfinite(moving_speed_mps))) {
+    os << "moving_speed_mps must be >= 0, got " << moving_speed_mps;
+  }
+  for (const double h : horizons_s) positive("horizons_s", h);
+  if (os.tellp() == 0 && region_camera && region_camera->width <= 0) {
+    os << "region_camera.width must be > 0, got " << region_camera->width;
+  }
+  if (os.tellp() == 0) {
+    ClearMotParams c;
+    c.gate_m = gate_m;
+    c.mostly_tracked_ratio = mostly_tracked_ratio;
+    c.mostly_lost_ratio = mostly_lost_ratio;
+    os << c.Validate();
+  }
+  return os.str();
+}
+
+void AddLog(LogData* data, const std::string& path, const EvalParams& params,
+            const std::function<void(const std::string&, double)>& progress) {
+  data->paths.push_back(path);
+  std::string why;
+  lcm_util::LogReader reader(path);
+  std::int64_t events = 0;
+  while (const lcm::LogEvent* ev = reader.Next()) {
+    if (progress && (++events % 256) == 0 && reader.FileSize() > 0) {
+      progress(path, static_cast<double>(reader.BytesRead()) / reader.FileSize());
+    }
+    const auto size = static_cast<std::size_t>(std::max<std::int32_t>(ev->datalen, 0));
+    if (ev->channel == params.truth_channel) {
+      vtrack::object_list_t msg;
+      if (lcm_util::Decode(ev->data, size, &msg, &why) != lcm_util::DecodeError::kNone) {
+        ++data->problems["decode_error_" + params.truth_channel];
+        continue;
+      }
+      Insert(&data->truth, msg, "truth", "ground-truth", path, &data->problems);
+    } else if (ev->channel == params.tracks_channel) {
+      vtrack::track_list_t msg;
+      if (lcm_util::Decode(ev->data, size, &msg, &why) != lcm_util::DecodeError::kNone) {
+        ++data->problems["decode_error_" + params.tracks_channel];
+        continue;
+      }
+      Insert(&data->tracks[msg.mode], msg, "tracks", "track-list (mode '" + msg.mode + "')",
+             path, &data->problems);
+    } else if (ev->channel == params.pose_channel) {
+      vtrack::pose_t msg;
+      if (lcm_util::Decode(ev->data, size, &msg, &why) != lcm_util::DecodeError::kNone) {
+        ++data->problems["decode_error_" + params.pose_channel];
+        continue;
+      }
+      if (auto pose = PoseFromMessage(msg)) {
+        data->pose_samples.emplace_back(msg.utime, *pose);
+      } else {
+        ++data->problems["invalid_pose"];
+      }
+    } else if (ev->channel == params.scan_channel && !data->body_from_sensor) {
+      vtrack::ladar_scan_t msg;
+      if (lcm_util::Decode(ev->data, size, &msg, &why) != lcm_util::DecodeError::kNone) {
+        ++data->problems["decode_error_" + params.scan_channel];
+        continue;
+      }
+      Eigen::Quaterniond q(msg.sensor_orientation[0], msg.sensor_orientation[1],
+                           msg.sensor_orientation[2], msg.sensor_orientation[3]);
+      const Eigen::Vector3d t(msg.sensor_pos[0], msg.sensor_pos[1], msg.sensor_pos[2]);
+      if (t.allFinite() && q.coeffs().allFinite() && q.norm() > 1e-6) {
+        Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
+        m.linear() = q.normalized().toRotationMatrix();
+        m.translation() = t;
+        data->body_from_sensor = m;
+        data->sweep_duration_us = msg.sweep_duration_us;
+      }
+    }
+  }
+  if (progress) progress(path, 1.0);
+
+  // Poses of every log so far, in time order (the logs may interleave).
+  std::stable_sort(data->pose_samples.begin(), data->pose_samples.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  data->poses.Clear();
+  std::int64_t duplicates = 0;
+  for (const auto& [utime, pose] : data->pose_samples) {
+    if (data->poses.Add(utime, pose) != PoseHistory::AddResult::kOk) ++duplicates;
+  }
+  if (duplicates > 0) {
+    data->problems["duplicate_pose"] = duplicates;
+  } else {
+    data->problems.erase("duplicate_pose");
+  }
+}
+
+LogData LoadLogs(const std::vector<std::string>& paths, const EvalParams& params,
+                 const std::function<void(const std::string&, double)>& progress) {
+  LogData data;
+  for (const std::string& path : paths) AddLog(&data, path, params, progress);
+  return data;
+}
+
+std::string SelectMode(const LogData& data, const EvalParams& params) {
+  if (data.truth.empty()) {
+    throw std::runtime_error("no ground truth (object_list_t on channel '" + params.truth_channel +
+                             "') in the logs");
+  }
+  if (data.tracks.empty()) {
+    throw std::runtime_error("no tracks (track_list_t on channel '" + params.tracks_channel +
+                             "') in the logs");
+  }
+  if (!params.mode.empty()) {
+    if (!data.tracks.count(params.mode)) {
+      std::string modes;
+      for (const auto& [m, l] : data.tracks) modes += (modes.empty() ? "'" : ", '") + m + "'";
+      throw std::runtime_error("no tracks of mode '" + params.mode + "' in the logs (found " +
+                               modes + ")");
+    }
+    return params.mode;
+  }
+  if (data.tracks.size() > 1) {
+    std::string modes;
+    for (const auto& [m, l] : data.tracks) modes += (modes.empty() ? "'" : ", '") + m + "'";
+    throw std::runtime_error("the logs hold tracks of several tracker modes (" + modes +
+                             "): choose one with --mode, or compare them with vtrack-compare");
+  }
+  return data.tracks.begin()->first;
+}
+
+EvalSummary Evaluate(const LogData& data, const EvalParams& params) {
+  if (const std::string err = params.Validate(); !err.empty()) {
+    throw std::runtime_error("invalid evaluation parameter: " + err);
+  }
+  EvalSummary s;
+  s.params = params;
+  s.logs = data.paths;
+  s.problems = data.problems;
+  s.mode = SelectMode(data, params);
+  const auto& track_lists = data.tracks.at(s.mode);
+  if (params.RegionEnabled() && data.poses.empty()) {
+    throw std::runtime_error("a scoring region (range/field of view) needs the ego pose, but the "
+                             "logs hold no pose_t on channel '" + params.pose_channel + "'");
+  }
+  const double half_fov = DegToRad(params.region_fov_deg) / 2.0;
+  Eigen::Isometry3d body_from_sensor = Eigen::Isometry3d::Identity();
+  if (params.region_camera) {
+    if (data.body_from_sensor) {
+      body_from_sensor = *data.body_from_sensor;
+    } else {
+      // Said in the summary's problems: the camera region then assumes sensor = body.
+      s.problems["camera_region_without_scan_mounting_assumed_sensor_at_body_origin"] = 1;
+    }
+  }
+  const auto max_pose_gap_us = static_cast<std::int64_t>(params.max_pose_gap_s * 1e6);
+
+  // Per scored frame: the message objects behind each ScoringFrame entry.
+  std::vector<ScoringFrame> frames;
+  std::vector<std::vector<const vtrack::object_t*>> frame_truth;
+  std::vector<std::vector<const vtrack::track_t*>> frame_tracks;
+
+  for (const auto& [utime, list] : track_lists) {
+    const auto gt_it = data.truth.find(utime);
+    if (gt_it == data.truth.end()) {
+      ++s.tracks_without_truth;
+      continue;
+    }
+    const vtrack::object_list_t& gt = gt_it->second;
+
+    std::optional<Eigen::Isometry3d> ego;
+    if (params.RegionEnabled()) {
+      ego = data.poses.At(utime, max_pose_gap_us);
+      if (!ego) {
+        ++s.problems["scan_without_pose"];
+        continue;
+      }
+    }
+    // z: the object's centre height in the world, or nullopt for a track (which has none).
+    auto in_region = [&](double x, double y, std::optional<double> z) {
+      if (!ego) return true;
+      const Eigen::Vector2d d = Eigen::Vector2d(x, y) - ego->translation().head<2>();
+      if (params.region_range_m > 0.0 && d.norm() > params.region_range_m) return false;
+      if (params.region_fov_deg < 360.0 &&
+          std::abs(AngleDiff(std::atan2(d.y(), d.x()), YawOf(*ego))) > half_fov) {
+        return false;
+      }
+      if (params.region_camera) {
+        const Eigen::Isometry3d world_from_sensor = *ego * body_from_sensor;
+        Eigen::Vector3d p_sensor = world_from_sensor.inverse() * Eigen::Vector3d(x, y, z.value_or(0.0));
+        if (!z) p_sensor.z() = params.region_camera->track_z_sensor_m;
+        if (!params.region_camera->Contains(p_sensor)) return false;
+      }
+      return true;
+    };
+
+    ScoringFrame f;
+    f.utime = utime;
+    std::vector<const vtrack::object_t*> scored, all_truth;
+    std::vector<bool> truth_scored;
+    std::set<std::int64_t> truth_ids;
+    for (const auto& o : gt.objects) {
+      if (!std::isfinite(o.x) || !std::isfinite(o.y)) {
+        ++s.problems["truth_not_finite"];
+        continue;
+      }
+      if (!truth_ids.insert(o.id).second) {
+        ++s.problems["truth_duplicate_id"];
+        continue;
+      }
+      const bool is_scored =
+          o.in_labelled_region && IsVehicleClass(o.object_class) &&
+          in_region(o.x, o.y,
+                    std::isfinite(o.z + 0.5 * o.height) ? std::optional<double>(o.z + 0.5 * o.height)
+                                                         : std::nullopt);
+      all_truth.push_back(&o);
+      truth_scored.push_back(is_scored);
+      if (is_scored) {
+        scored.push_back(&o);
+        f.gt_ids.push_back(o.id);
+        f.gt_xy.emplace_back(o.x, o.y);
+      }
+    }
+
+    // Candidate tracks, then drop those paired with ignored truth, or unpaired outside the region.
+    std::vector<const vtrack::track_t*> candidates;
+    std::set<std::int64_t> track_ids;
+    for (const auto& tr : list.tracks) {
+      const bool status_ok = tr.status == vtrack::track_t::STATUS_CONFIRMED ||
+                             (params.score_coasting && tr.status == vtrack::track_t::STATUS_COASTING);
+      if (!status_ok || tr.object_class != vtrack::track_t::CLASS_VEHICLE) continue;
+      if (!std::isfinite(tr.x) || !std::isfinite(tr.y)) {
+        ++s.problems["track_not_finite"];
+        continue;
+      }
+      if (!track_ids.insert(tr.id).second) {
+        ++s.problems["track_duplicate_id"];
+        continue;
+      }
+      candidates.push_back(&tr);
+    }
+    Eigen::MatrixXd cost(candidates.size(), all_truth.size());
+    for (std::size_t j = 0; j < candidates.size(); ++j) {
+      for (std::size_t i = 0; i < all_truth.size(); ++i) {
+        const double d = std::hypot(candidates[j]->x - all_truth[i]->x,
+                                    candidates[j]->y - all_truth[i]->y);
+        cost(j, i) = d < params.gate_m ? d : kInf;
+      }
+    }
+    std::vector<int> partner(candidates.size(), -1);
+    for (const auto& [j, i] : GatedAssignment(cost)) partner[j] = i;
+    std::vector<const vtrack::track_t*> kept;
+    for (std::size_t j = 0; j < candidates.size(); ++j) {
+      const vtrack::track_t* tr = candidates[j];
+      if (partner[j] >= 0 && !truth_scored[partner[j]]) {
+        ++s.ignored_track_detections;
+        continue;
+      }
+      if (partner[j] < 0 && !in_region(tr->x, tr->y, std::nullopt)) {
+        ++s.outside_region_track_detections;
+        continue;
+      }
+      kept.push_back(tr);
+      f.track_ids.push_back(tr->id);
+      f.track_xy.emplace_back(tr->x, tr->y);
+    }
+    frames.push_back(std::move(f));
+    frame_truth.push_back(std::move(scored));
+    frame_tracks.push_back(std::move(kept));
+  }
+  for (const auto& [utime, gt] : data.truth) {
+    if (!track_lists.count(utime)) ++s.scans_without_tracks;
+  }
+  if (frames.empty()) {
+    throw std::runtime_error("no scan has both ground truth and tracks of mode '" + s.mode +
+                             "' with the same utime: are these logs of the same run?");
+  }
+
+  ClearMotParams cp;
+  cp.gate_m = params.gate_m;
+  cp.mostly_tracked_ratio = params.mostly_tracked_ratio;
+  cp.mostly_lost_ratio = params.mostly_lost_ratio;
+  s.clear = ComputeClearMot(frames, cp);
+  HotaParams hp;
+  hp.similarity_gate_m = params.hota_gate_m;
+  s.hota = ComputeHota(frames, hp);
+  s.scans = static_cast<std::int64_t>(frames.size());
+
+  // State errors on the CLEAR MOT matches.
+  const std::int64_t t0 = frames.front().utime;
+  const std::size_t nh = params.horizons_s.size();
+  Stats pos, head, speed, yaw_rate, axle, nees;
+  std::vector<Stats> pred(nh);
+  std::int64_t flips = 0, nees_inside = 0;
+  struct PerTrack {
+    TrackRow row;
+    Stats pos, head, speed, yaw_rate, axle, nees;
+    std::vector<Stats> pred;
+    std::map<std::int64_t, std::int64_t> truth_counts;
+  };
+  std::map<std::int64_t, PerTrack> per_track;
+
+  for (std::size_t t = 0; t < frames.size(); ++t) {
+    const ScoringFrame& f = frames[t];
+    const double ts = static_cast<double>(f.utime - t0) * 1e-6;
+    ScanCounts c;
+    c.t_s = ts;
+    c.utime = f.utime;
+    c.gt = static_cast<int>(f.gt_ids.size());
+    c.tp = static_cast<int>(s.clear.matches[t].size());
+    c.fn = c.gt - c.tp;
+    c.fp = static_cast<int>(f.track_ids.size()) - c.tp;
+    for (std::size_t j = 0; j < f.track_ids.size(); ++j) {
+      PerTrack& p = per_track[f.track_ids[j]];
+      if (p.row.scans == 0) {
+        p.row.track_id = f.track_ids[j];
+        p.row.first_s = ts;
+        p.pred.resize(nh);
+      }
+      p.row.last_s = ts;
+      ++p.row.scans;
+    }
+    for (const Match& m : s.clear.matches[t]) {
+      const vtrack::object_t& o = *frame_truth[t][m.gt];
+      const vtrack::track_t& tr = *frame_tracks[t][m.track];
+      PairSample ps;
+      ps.t_s = ts;
+      ps.utime = f.utime;
+      ps.truth_id = o.id;
+      ps.track_id = tr.id;
+      ps.id_switch = m.id_switch;
+      c.id_switches += m.id_switch ? 1 : 0;
+      ps.position_error_m = m.distance_m;
+      const double dth = AngleDiff(tr.theta, o.yaw);
+      ps.heading_flipped = std::abs(dth) > kPi / 2.0;
+      const double folded = ps.heading_flipped ? WrapToPi(dth + kPi) : dth;
+      ps.heading_error_deg = RadToDeg(folded);
+      const double truth_speed = std::hypot(o.vx, o.vy);
+      ps.speed_error_mps = tr.speed - truth_speed;
+      ps.yaw_rate_error_dps = RadToDeg(tr.yaw_rate - o.yaw_rate);
+      ps.rear_axle_error_m = kNaN;
+      if (std::isfinite(tr.rear_axle_offset) && std::isfinite(o.rear_axle_offset) &&
+          truth_speed > params.moving_speed_mps) {
+        const double l = ps.heading_flipped ? -tr.rear_axle_offset : tr.rear_axle_offset;
+        ps.rear_axle_error_m = l - o.rear_axle_offset;
+      }
+      // NEES of (x, y, theta).
+      Eigen::Matrix3d cov;
+      for (int r = 0; r < 3; ++r) {
+        for (int k = 0; k < 3; ++k) cov(r, k) = tr.cov[3 * r + k];
+      }
+      ps.nees = kNaN;
+      if (cov.allFinite() && (cov - cov.transpose()).cwiseAbs().maxCoeff() <=
+                                 1e-9 * std::max(1.0, cov.cwiseAbs().maxCoeff())) {
+        Eigen::LLT<Eigen::Matrix3d> llt(0.5 * (cov + cov.transpose()));
+        if (llt.info() == Eigen::Success) {
+          const Eigen::Vector3d e(tr.x - o.x, tr.y - o.y, folded);
+          ps.nees = e.dot(llt.solve(e));
+        }
+      }
+      if (!std::isfinite(ps.nees)) ++s.nees_invalid;
+      // Prediction at each horizon.
+      ps.prediction_error_m.assign(nh, kNaN);
+      for (std::size_t h = 0; h < nh; ++h) {
+        const auto p = PredictedAt(tr, params.horizons_s[h]);
+        if (!p) continue;
+        const auto when = f.utime + static_cast<std::int64_t>(std::llround(params.horizons_s[h] * 1e6));
+        const auto truth_then = TruthAt(data.truth, o.id, when, params.max_truth_gap_s);
+        if (!truth_then) continue;
+        ps.prediction_error_m[h] = (*p - *truth_then).norm();
+      }
+
+      pos.Add(ps.position_error_m);
+      head.Add(ps.heading_error_deg);
+      speed.Add(ps.speed_error_mps);
+      yaw_rate.Add(ps.yaw_rate_error_dps);
+      axle.Add(ps.rear_axle_error_m);
+      nees.Add(ps.nees);
+      if (std::isfinite(ps.nees) && ps.nees <= kChi2Dof3Quantile95) ++nees_inside;
+      flips += ps.heading_flipped ? 1 : 0;
+      for (std::size_t h = 0; h < nh; ++h) pred[h].Add(ps.prediction_error_m[h]);
+
+      PerTrack& p = per_track[tr.id];
+      ++p.row.matched;
+      ++p.truth_counts[o.id];
+      p.row.id_switches += m.id_switch ? 1 : 0;
+      p.pos.Add(ps.position_error_m);
+      p.head.Add(ps.heading_error_deg);
+      p.speed.Add(ps.speed_error_mps);
+      p.yaw_rate.Add(ps.yaw_rate_error_dps);
+      p.axle.Add(ps.rear_axle_error_m);
+      p.nees.Add(ps.nees);
+      for (std::size_t h = 0; h < nh; ++h) p.pred[h].Add(ps.prediction_error_m[h]);
+      s.pairs.push_back(std::move(ps));
+    }
+    s.per_scan.push_back(c);
+  }
+
+  s.position_rmse_m = pos.Rms();
+  s.heading_rmse_deg = head.Rms();
+  s.heading_flip_fraction = pos.n > 0 ? static_cast<double>(flips) / pos.n : kNaN;
+  s.speed_rmse_mps = speed.Rms();
+  s.yaw_rate_rmse_dps = yaw_rate.Rms();
+  s.rear_axle_rmse_m = axle.Rms();
+  s.rear_axle_samples = axle.n;
+  for (std::size_t h = 0; h < nh; ++h) {
+    s.prediction_error_m.push_back(pred[h].Mean());
+    s.prediction_samples.push_back(pred[h].n);
+  }
+  s.nees_mean = nees.Mean();
+  s.nees_samples = nees.n;
+  s.nees_within_95 = nees.n > 0 ? static_cast<double>(nees_inside) / nees.n : kNaN;
+  s.scored_tracks = static_cast<std::int64_t>(per_track.size());
+  for (auto& [id, p] : per_track) {
+    TrackRow& row = p.row;
+    for (const auto& [truth_id, n] : p.truth_counts) {
+      if (n > row.truth_scans) {
+        row.truth_scans = n;
+        row.truth_id = truth_id;
+      }
+    }
+    row.position_rmse_m = p.pos.Rms();
+    row.heading_rmse_deg = p.head.Rms();
+    row.speed_rmse_mps = p.speed.Rms();
+    row.yaw_rate_rmse_dps = p.yaw_rate.Rms();
+    row.rear_axle_rmse_m = p.axle.Rms();
+    row.nees_mean = p.nees.Mean();
+    for (std::size_t h = 0; h < nh; ++h) row.prediction_error_m.push_back(p.pred[h].Mean());
+    s.per_track.push_back(row);
+  }
+  return s;
+}
+
+}  // namespace vtrack::eval

@@ -1,0 +1,147 @@
+#include "log_tools/eval/kitti_export.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "log_tools/eval/report.h"
+#include "tracker/core/angle.h"
+
+namespace vtrack::eval {
+
+std::string KittiExportParams::Validate() const {
+  std::ostringstream os;
+  if (image_width <= 0 || image_height <= 0) {
+    os << "image size must be positive, got " << image_width << "x" << image_height;
+  } else if (!(sensor_height_m > 0.0 && std::isfinite(sensor_height_m))) {
+    os << "sensor_height_m must be > 0, got " << sensor_height_m;
+  } else if (!(box_height_m > 0.0 && std::isfinite(box_height_m))) {
+    os << "box_height_m must be > 0, got " << box_height_m;
+  } else if (!std::isfinite(time_offset_s)) {
+    os << "time_offset_s must be finite, got " << time_offset_s;
+  } else if (!P2.allFinite() || P2.row(2).head<3>().norm() == 0.0) {
+    os << "P2 is not a projection matrix";
+  }
+  return os.str();
+}
+
+KittiExportStats ExportKittiTracking(const LogData& data, const std::string& mode,
+                                     const KittiExportParams& params, const std::string& path) {
+  if (const std::string err = params.Validate(); !err.empty()) {
+    throw std::runtime_error("invalid KITTI export parameter: " + err);
+  }
+  const auto lists = data.tracks.find(mode);
+  if (lists == data.tracks.end()) {
+    throw std::runtime_error("no tracks of mode '" + mode + "' to export");
+  }
+  if (data.poses.empty()) {
+    throw std::runtime_error("the KITTI export needs the ego pose (pose_t), and the logs hold none");
+  }
+  KittiExportStats stats;
+  stats.time_offset_s = params.time_offset_s >= 0.0
+                            ? params.time_offset_s
+                            : 0.5e-6 * static_cast<double>(data.sweep_duration_us.value_or(0));
+  const Eigen::Isometry3d body_from_sensor =
+      data.body_from_sensor.value_or(Eigen::Isometry3d::Identity());
+  const auto offset_us = static_cast<std::int64_t>(std::llround(stats.time_offset_s * 1e6));
+
+  struct Line {
+    std::int64_t frame, id;
+    std::string text;
+  };
+  std::vector<Line> lines;
+  std::int64_t index = 0;
+  for (const auto& [utime, list] : lists->second) {
+    ++stats.frames;
+    const std::int64_t frame = list.scan_seq >= 0 ? list.scan_seq : index;
+    ++index;
+    const auto ego = data.poses.At(utime + offset_us, 500'000);
+    if (!ego) {
+      ++stats.frames_without_pose;
+      continue;
+    }
+    const Eigen::Isometry3d sensor_from_world = (*ego * body_from_sensor).inverse();
+    for (const auto& tr : list.tracks) {
+      const bool status_ok = tr.status == vtrack::track_t::STATUS_CONFIRMED ||
+                             (params.score_coasting && tr.status == vtrack::track_t::STATUS_COASTING);
+      if (!status_ok || tr.object_class != vtrack::track_t::CLASS_VEHICLE) continue;
+      const double dt = stats.time_offset_s;
+      const double speed = std::isfinite(tr.speed) ? tr.speed : 0.0;
+      const double vh = std::isfinite(tr.velocity_heading) ? tr.velocity_heading : tr.theta;
+      const double yaw_rate = std::isfinite(tr.yaw_rate) ? tr.yaw_rate : 0.0;
+      const Eigen::Vector3d centre_w(tr.x + speed * std::cos(vh) * dt,
+                                     tr.y + speed * std::sin(vh) * dt, 0.0);
+      const double theta = tr.theta + yaw_rate * dt;
+      if (!centre_w.allFinite() || !std::isfinite(theta) || !(tr.length > 0.0) ||
+          !(tr.width > 0.0)) {
+        continue;
+      }
+      // Box in the sensor frame: bottom centre on the road, axes in the sensor's xy plane.
+      Eigen::Vector3d c_s = sensor_from_world * centre_w;
+      c_s.z() = -params.sensor_height_m;
+      Eigen::Vector3d h_s = sensor_from_world.linear() * Eigen::Vector3d(std::cos(theta), std::sin(theta), 0.0);
+      h_s.z() = 0.0;
+      h_s.normalize();
+      const Eigen::Vector3d n_s(-h_s.y(), h_s.x(), 0.0);
+      const Eigen::Vector3d up(0.0, 0.0, 1.0);
+
+      std::array<Eigen::Vector3d, 8> corners;
+      int k = 0;
+      for (const double a : {0.5, -0.5}) {
+        for (const double b : {0.5, -0.5}) {
+          for (const double z : {0.0, params.box_height_m}) {
+            corners[k++] = c_s + a * tr.length * h_s + b * tr.width * n_s + z * up;
+          }
+        }
+      }
+      double u0 = std::numeric_limits<double>::infinity(), v0 = u0, u1 = -u0, v1 = -u0;
+      bool behind = false;
+      for (const auto& c : corners) {
+        const Eigen::Vector3d r = params.rect_from_sensor * c;
+        const Eigen::Vector3d img = params.P2 * r.homogeneous();
+        if (r.z() < 0.1 || img.z() <= 0.0) {
+          behind = true;
+          break;
+        }
+        u0 = std::min(u0, img.x() / img.z());
+        u1 = std::max(u1, img.x() / img.z());
+        v0 = std::min(v0, img.y() / img.z());
+        v1 = std::max(v1, img.y() / img.z());
+      }
+      u0 = std::max(u0, 0.0);
+      v0 = std::max(v0, 0.0);
+      u1 = std::min(u1, params.image_width - 1.0);
+      v1 = std::min(v1, params.image_height - 1.0);
+      if (behind || !(u1 > u0) || !(v1 > v0)) {
+        ++stats.outside_image;
+        continue;
+      }
+      const Eigen::Vector3d bottom_r = params.rect_from_sensor * c_s;
+      const Eigen::Vector3d d_r = params.rect_from_sensor.linear() * h_s;
+      const double rotation_y = std::atan2(-d_r.z(), d_r.x());
+      const double alpha = WrapToPi(rotation_y - std::atan2(bottom_r.x(), bottom_r.z()));
+      char buf[512];
+      std::snprintf(buf, sizeof(buf),
+                    "%lld %lld Car -1 -1 %.6f %.2f %.2f %.2f %.2f %.6f %.6f %.6f %.6f %.6f %.6f "
+                    "%.6f %.6f\n",
+                    static_cast<long long>(frame), static_cast<long long>(tr.id), alpha, u0, v0,
+                    u1, v1, params.box_height_m, tr.width, tr.length, bottom_r.x(), bottom_r.y(),
+                    bottom_r.z(), rotation_y, 1.0);
+      lines.push_back({frame, tr.id, buf});
+    }
+  }
+  std::stable_sort(lines.begin(), lines.end(), [](const Line& a, const Line& b) {
+    return a.frame != b.frame ? a.frame < b.frame : a.id < b.id;
+  });
+  std::string text;
+  for (const auto& l : lines) text += l.text;
+  WriteTextFile(path, text);
+  stats.lines = static_cast<std::int64_t>(lines.size());
+  return stats;
+}
+
+}  // namespace vtrack::eval

@@ -1,0 +1,155 @@
+// vtrack-compare: its orchestration with stand-in tools whose results are known
+// (fake_vtrack_tool.cc), and, when the real simulator and tracker are built, one real run.
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "tests/log_tools/synthetic_run.h"
+#include "tests/support/subprocess.h"
+#include "tests/support/test_env.h"
+
+namespace vtrack::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+class CompareTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    exe_ = BinDir() + "/vtrack-compare";
+    if (!fs::exists(exe_)) GTEST_SKIP() << exe_ << " is not built";
+    dir_ = ScratchDir("compare");
+    // The stand-in tools: links named like the real ones to the fake (built beside this test).
+    const fs::path fake = fs::read_symlink("/proc/self/exe").parent_path() / "fake_vtrack_tool";
+    ASSERT_TRUE(fs::exists(fake)) << fake;
+    fake_bin_ = dir_ + "/bin";
+    fs::create_directories(fake_bin_);
+    for (const char* name : {"vtrack-sim-log", "vtrack-tracker", "vtrack-kitti2lcm"}) {
+      fs::create_symlink(fake, fs::path(fake_bin_) / name);
+    }
+  }
+  int RunTool(std::vector<std::string> args, std::string* output, std::vector<std::string> env = {}) {
+    args.insert(args.begin(), exe_);
+    const std::string log = dir_ + "/out.txt";
+    Subprocess p(args, log, env);
+    auto rc = p.Wait(std::chrono::seconds(120));
+    const int status = rc ? *rc : p.Stop();
+    *output = ReadFile(log);
+    return status;
+  }
+  std::string exe_, dir_, fake_bin_;
+};
+
+TEST_F(CompareTest, HelpAndBadOptions) {
+  std::string out;
+  EXPECT_EQ(RunTool({"--help"}, &out), 0);
+  EXPECT_NE(out.find("--scenarios"), std::string::npos);
+  EXPECT_EQ(RunTool({}, &out), 2);
+  EXPECT_NE(out.find("nothing to compare"), std::string::npos) << out;
+  EXPECT_EQ(RunTool({"--scenarios", "a", "--modes", "ism,foo"}, &out), 2);
+  EXPECT_NE(out.find("'foo'"), std::string::npos) << out;
+  EXPECT_EQ(RunTool({"--scenarios", "a", "--gate", "-2"}, &out), 2);
+  EXPECT_NE(out.find("gate_m"), std::string::npos) << out;
+  EXPECT_EQ(RunTool({"--scenarios", "a", "--bin-dir", dir_ + "/nowhere"}, &out), 1);
+  EXPECT_NE(out.find("vtrack-sim-log"), std::string::npos) << out;
+}
+
+TEST_F(CompareTest, ThreeModesOnTwoScenariosAndKitti) {
+  // A KITTI folder with a calibration (camera 2 looking along velo x, +-50 deg).
+  const std::string kitti = dir_ + "/kitti";
+  fs::create_directories(kitti + "/calib");
+  {
+    std::ofstream c(kitti + "/calib/0000.txt");
+    const char* p = "500 0 600 0 0 500 180 0 0 0 1 0";
+    c << "P0: " << p << "\nP1: " << p << "\nP2: " << p << "\nP3: " << p << "\n"
+      << "R0_rect: 1 0 0 0 1 0 0 0 1\nTr_velo_to_cam: 0 -1 0 0 0 0 -1 0 1 0 0 0\n";
+  }
+  const std::string json = dir_ + "/cmp.json", plots = dir_ + "/plots", calls = dir_ + "/calls.txt";
+  std::string out;
+  ASSERT_EQ(RunTool({"--scenarios", "alpha,config/beta.yaml", "--kitti", kitti, "--bin-dir", fake_bin_,
+                 "--json", json, "--plots", plots, "--seed", "7"},
+                &out, {"FAKE_TOOL_LOG=" + calls}), 0) << out;
+  // The table: a header, a rule and 3 x 3 rows.
+  for (const char* s : {"alpha", "beta", "kitti_0000", "ism", "vasm", "mht", "MOTA", "HOTA"}) {
+    EXPECT_NE(out.find(s), std::string::npos) << s << "\n" << out;
+  }
+  // The command lines of DESIGN section 8.
+  const std::string c = ReadFile(calls);
+  EXPECT_NE(c.find("vtrack-sim-log --scenario alpha --out run.lcm --seed 7"), std::string::npos) << c;
+  EXPECT_NE(c.find("vtrack-sim-log --scenario config/beta.yaml --out run.lcm"), std::string::npos) << c;
+  EXPECT_NE(c.find("vtrack-kitti2lcm --kitti kitti --sequence 0000 --out run.lcm"), std::string::npos) << c;
+  EXPECT_NE(c.find("vtrack-tracker --input run.lcm --output tracks_vasm.lcm --mode vasm"), std::string::npos) << c;
+
+  const YAML::Node j = YAML::LoadFile(json);
+  ASSERT_EQ(j.size(), 3u);
+  // Scenarios: track 1 is off by the mode's offset, track 2 exact: position RMSE = offset / sqrt 2.
+  const std::map<std::string, double> offset = {{"ism", 0.5}, {"vasm", 0.3}, {"mht", 0.1}};
+  for (const char* item : {"alpha", "beta"}) {
+    for (const auto& [mode, off] : offset) {
+      const YAML::Node s = j[item][mode];
+      ASSERT_TRUE(s.IsMap()) << item << " " << mode;
+      EXPECT_EQ(s["mode"].as<std::string>(), mode);
+      EXPECT_NEAR(s["position_rmse_m"].as<double>(), off / std::sqrt(2.0), 1e-9) << item << mode;
+      EXPECT_NEAR(s["mota"].as<double>(), 0.5, 1e-9);
+      for (const char* key : {"motp_m", "id_switches", "fragmentations", "hota", "heading_rmse_deg",
+                              "speed_rmse_mps", "nees_mean", "scans", "gt_objects"}) {
+        EXPECT_TRUE(s[key].IsDefined()) << key;
+      }
+      EXPECT_TRUE(s["prediction_error_m"]["3"].IsDefined());
+    }
+  }
+  // KITTI: scored in the camera view within 40 m, so the false positive behind the ego is dropped.
+  EXPECT_EQ(j["kitti_0000"]["mht"]["false_positives"].as<int>(), 0);
+  EXPECT_TRUE(j["kitti_0000"]["mht"]["params"]["region_camera"].as<bool>());
+  EXPECT_NEAR(j["kitti_0000"]["mht"]["params"]["region_range_m"].as<double>(), 40.0, 1e-12);
+
+  for (const char* png : {"alpha_modes.png", "beta_modes.png", "kitti_0000_modes.png"}) {
+    EXPECT_FALSE(cv::imread(plots + "/" + png).empty()) << png;
+  }
+}
+
+TEST_F(CompareTest, AFailedModeIsReportedAndTheRestStillScored) {
+  const std::string json = dir_ + "/cmp.json";
+  std::string out;
+  EXPECT_EQ(RunTool({"--scenarios", "alpha,fail_sim", "--bin-dir", fake_bin_, "--json", json},
+                &out, {"FAKE_TRACKER_FAIL_MODE=vasm"}), 1) << out;
+  EXPECT_NE(out.find("mode vasm fails"), std::string::npos) << out;          // the child's output
+  EXPECT_NE(out.find("scenario fail_sim fails"), std::string::npos) << out;
+  EXPECT_NE(out.find("failed"), std::string::npos) << out;                   // in the table
+  const YAML::Node j = YAML::LoadFile(json);
+  EXPECT_TRUE(j["alpha"]["ism"].IsMap());
+  EXPECT_TRUE(j["alpha"]["vasm"].IsNull());
+  EXPECT_TRUE(j["fail_sim"]["mht"].IsNull());
+}
+
+TEST(CompareRealToolsTest, PaperScenarioThroughTheRealSimulatorAndTracker) {
+  const std::string bin = BinDir();
+  for (const char* tool : {"vtrack-compare", "vtrack-sim-log", "vtrack-tracker"}) {
+    if (!fs::exists(bin + "/" + tool)) {
+      GTEST_SKIP() << bin << "/" << tool << " is not built yet: the real-tool run of vtrack-compare "
+                   << "needs the simulator and the tracker";
+    }
+  }
+  const std::string scenario = SourceDir() + "/config/scenarios/paper_fig4_turn.yaml";
+  if (!fs::exists(scenario)) GTEST_SKIP() << scenario << " does not exist yet";
+  const std::string dir = ScratchDir("compare_real"), json = dir + "/cmp.json";
+  const int rc = RunCommand({bin + "/vtrack-compare", "--scenarios", scenario, "--json", json,
+                             "--work-dir", dir + "/work", "--quiet"},
+                            dir + "/out.txt", std::chrono::minutes(5));
+  ASSERT_EQ(rc, 0) << ReadFile(dir + "/out.txt");
+  const YAML::Node j = YAML::LoadFile(json);
+  for (const char* mode : {"ism", "vasm", "mht"}) {
+    const YAML::Node s = j["paper_fig4_turn"][mode];
+    ASSERT_TRUE(s.IsMap()) << mode;
+    EXPECT_GT(s["scans"].as<int>(), 0) << mode;
+    EXPECT_GE(s["gt_objects"].as<int>(), 1) << mode;
+  }
+}
+
+}  // namespace
+}  // namespace vtrack::testing

@@ -1,0 +1,156 @@
+// vtrack-eval as a process: options, exit codes, and its outputs (JSON read back with yaml-cpp,
+// an independent parser; CSV; PNG files; the KITTI export checked against the calibration).
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+
+#include "sensor_driver/kitti/kitti_io.h"
+#include "tests/log_tools/synthetic_run.h"
+#include "tests/support/subprocess.h"
+#include "tests/support/test_env.h"
+
+namespace vtrack::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+class EvalCliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    exe_ = BinDir() + "/vtrack-eval";
+    if (!fs::exists(exe_)) GTEST_SKIP() << exe_ << " is not built";
+    dir_ = ScratchDir("eval_cli");
+    run_ = dir_ + "/run.lcm";
+    tracks_ = dir_ + "/tracks.lcm";
+    WriteSyntheticRun(run_);
+    WriteSyntheticTracks(tracks_, "vasm");
+  }
+  int RunTool(std::vector<std::string> args, std::string* output) {
+    args.insert(args.begin(), exe_);
+    const std::string log = dir_ + "/out.txt";
+    const int rc = RunCommand(args, log);
+    *output = ReadFile(log);
+    return rc;
+  }
+  std::string exe_, dir_, run_, tracks_;
+};
+
+TEST_F(EvalCliTest, HelpAndBadOptions) {
+  std::string out;
+  EXPECT_EQ(RunTool({"--help"}, &out), 0);
+  EXPECT_NE(out.find("--json"), std::string::npos);
+  EXPECT_NE(out.find("--kitti-out"), std::string::npos);
+  EXPECT_EQ(RunTool({}, &out), 2);
+  EXPECT_NE(out.find("no LOG"), std::string::npos) << out;
+  EXPECT_EQ(RunTool({run_, "--gate", "0"}, &out), 2);
+  EXPECT_NE(out.find("gate_m must be > 0, got 0"), std::string::npos) << out;
+  EXPECT_EQ(RunTool({run_, "--horizons", "1,x"}, &out), 2);
+  EXPECT_NE(out.find("'x'"), std::string::npos) << out;
+  EXPECT_EQ(RunTool({run_, "--region-camera"}, &out), 2);
+  EXPECT_NE(out.find("--kitti-calib"), std::string::npos) << out;
+  EXPECT_EQ(RunTool({dir_ + "/missing.lcm"}, &out), 1);
+  EXPECT_NE(out.find("missing.lcm"), std::string::npos) << out;
+  EXPECT_EQ(RunTool({run_}, &out), 1);  // no tracks in it
+  EXPECT_NE(out.find("no tracks"), std::string::npos) << out;
+}
+
+TEST_F(EvalCliTest, WritesJsonCsvAndPlots) {
+  const std::string json = dir_ + "/m.json", csv = dir_ + "/t.csv", plots = dir_ + "/plots";
+  std::string out;
+  ASSERT_EQ(RunTool({run_, tracks_, "--json", json, "--csv", csv, "--plots", plots}, &out), 0) << out;
+  EXPECT_NE(out.find("MOTA 0.500"), std::string::npos) << out;
+
+  const YAML::Node j = YAML::LoadFile(json);
+  for (const char* key : {"mota", "motp_m", "id_switches", "fragmentations", "hota",
+                          "position_rmse_m", "heading_rmse_deg", "speed_rmse_mps",
+                          "prediction_error_m", "nees_mean", "scans", "gt_objects"}) {
+    EXPECT_TRUE(j[key].IsDefined()) << key;
+  }
+  EXPECT_EQ(j["mode"].as<std::string>(), "vasm");
+  EXPECT_NEAR(j["mota"].as<double>(), 0.5, 1e-9);
+  EXPECT_EQ(j["scans"].as<int>(), kScans);
+  EXPECT_EQ(j["gt_objects"].as<int>(), 2);
+  EXPECT_EQ(j["id_switches"].as<int>(), 0);
+  for (const char* h : {"1", "2", "3"}) {
+    EXPECT_NEAR(j["prediction_error_m"][h].as<double>(), 1.0, 1e-6) << h;
+  }
+  EXPECT_NEAR(j["nees_mean"].as<double>(), 1.0, 1e-6);
+
+  // CSV: a header and one row per scored track (1, 2, 7).
+  std::ifstream in(csv);
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  ASSERT_EQ(lines.size(), 4u);
+  EXPECT_EQ(lines[0].rfind("track_id,", 0), 0u);
+  EXPECT_EQ(lines[1].rfind("1,", 0), 0u);
+  EXPECT_EQ(lines[3].rfind("7,", 0), 0u);
+
+  for (const char* png : {"errors_over_time.png", "detections_over_time.png", "prediction_error.png"}) {
+    const cv::Mat img = cv::imread(plots + "/" + png);
+    EXPECT_FALSE(img.empty()) << png;
+    EXPECT_GT(img.cols, 300) << png;
+  }
+}
+
+TEST_F(EvalCliTest, KittiExportFollowsTheCalibration) {
+  // A calibration with P2 = [500 0 600 0; 0 500 180 0; 0 0 1 0], R0_rect = I and
+  // Tr_velo_to_cam the axis permutation (velo x forward, y left, z up -> cam x right, y down,
+  // z forward). The world is the velo frame (the ego stays at the origin).
+  const std::string calib = dir_ + "/calib.txt";
+  {
+    std::ofstream c(calib);
+    const char* p = "500 0 600 0 0 500 180 0 0 0 1 0";
+    c << "P0: " << p << "\nP1: " << p << "\nP2: " << p << "\nP3: " << p << "\n"
+      << "R0_rect: 1 0 0 0 1 0 0 0 1\n"
+      << "Tr_velo_to_cam: 0 -1 0 0 0 0 -1 0 1 0 0 0\n"
+      << "Tr_imu_to_velo: 1 0 0 0 0 1 0 0 0 0 1 0\n";
+  }
+  const std::string out_file = dir_ + "/kitti.txt";
+  std::string out;
+  ASSERT_EQ(RunTool({run_, tracks_, "--kitti-calib", calib, "--kitti-out", out_file,
+                 "--kitti-image-size", "1200x360"}, &out), 0) << out;
+  std::ifstream in(out_file);
+  int lines = 0, b_lines = 0;
+  for (std::string l; std::getline(in, l);) {
+    ++lines;
+    std::istringstream ss(l);
+    long long frame = 0, id = 0;
+    std::string type;
+    double trunc, occ, alpha, x1, y1, x2, y2, h, w, len, x, y, z, ry, score;
+    ASSERT_TRUE(ss >> frame >> id >> type >> trunc >> occ >> alpha >> x1 >> y1 >> x2 >> y2 >> h >>
+                w >> len >> x >> y >> z >> ry >> score) << l;
+    EXPECT_EQ(type, "Car");
+    EXPECT_TRUE(x1 >= 0 && x2 <= 1199 && x1 < x2 && y1 >= 0 && y2 <= 359 && y1 < y2) << l;
+    EXPECT_NE(id, 3);  // CLASS_OTHER is not a vehicle
+    EXPECT_NE(id, 6);  // tentative
+    if (id == 2) {
+      // Track 2: B at velo (10, -5), theta = 0.3 - pi (stationary, so the time advance does not
+      // move it). Bottom centre: velo (10, -5, -1.73) -> cam (5, 1.73, 10). KITTI's relation
+      // yaw_velo = -rotation_y - pi/2.
+      ++b_lines;
+      EXPECT_NEAR(x, 5.0, 1e-5);
+      EXPECT_NEAR(y, 1.73, 1e-5);
+      EXPECT_NEAR(z, 10.0, 1e-5);
+      EXPECT_NEAR(std::remainder(-ry - std::numbers::pi / 2 - (0.3 - std::numbers::pi),
+                                 2 * std::numbers::pi), 0.0, 1e-5);
+      EXPECT_NEAR(std::remainder(alpha - (ry - std::atan2(x, z)), 2 * std::numbers::pi), 0.0, 1e-5);
+      EXPECT_NEAR(h, 1.6, 1e-9);
+      EXPECT_NEAR(w, 1.8, 1e-9);
+      EXPECT_NEAR(len, 4.5, 1e-9);
+    }
+  }
+  EXPECT_EQ(b_lines, kScans);  // the extra track list at +100 s has no ego pose
+  EXPECT_NE(out.find("1 frames without pose"), std::string::npos) << out;
+  EXPECT_GT(lines, b_lines);
+  EXPECT_NE(out.find("states advanced 0.05 s"), std::string::npos) << out;  // half of 100 ms
+}
+
+}  // namespace
+}  // namespace vtrack::testing

@@ -1,0 +1,174 @@
+// The evaluator on a synthetic run whose errors are set by construction (synthetic_run.h): every
+// expected value below is worked out from that construction, not taken from the code.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "lcmtypes/util/log_reader.h"
+#include "log_tools/eval/evaluator.h"
+#include "tests/log_tools/synthetic_run.h"
+#include "tests/support/test_env.h"
+
+namespace vtrack::eval {
+namespace {
+
+using vtrack::testing::kScans;
+
+constexpr double kPi = std::numbers::pi;
+
+class EvaluatorTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = vtrack::testing::ScratchDir("evaluator");
+    run_ = dir_ + "/run.lcm";
+    tracks_ = dir_ + "/tracks.lcm";
+    vtrack::testing::WriteSyntheticRun(run_);
+    vtrack::testing::WriteSyntheticTracks(tracks_, "mht");
+  }
+  std::string dir_, run_, tracks_;
+};
+
+TEST_F(EvaluatorTest, MetricsOfTheSyntheticRun) {
+  const EvalParams params;
+  const LogData data = LoadLogs({run_, tracks_}, params);
+  const EvalSummary s = Evaluate(data, params);
+  EXPECT_EQ(s.mode, "mht");
+  EXPECT_EQ(s.scans, kScans);
+  EXPECT_EQ(s.scans_without_tracks, 1);   // the ground truth at -1 s
+  EXPECT_EQ(s.tracks_without_truth, 1);   // the track list at +100 s
+  // Scored: cars A and B (the pedestrian and the car outside the labelled region are not).
+  EXPECT_EQ(s.clear.gt_objects, 2);
+  EXPECT_EQ(s.clear.gt_detections, 2 * kScans);
+  // Tracks 1 and 2 match; 7 is a false positive in every scan; 3 (other), 4 and 5 (on ignored
+  // truth) and 6 (tentative) are not scored.
+  EXPECT_EQ(s.clear.true_positives, 2 * kScans);
+  EXPECT_EQ(s.clear.false_positives, kScans);
+  EXPECT_EQ(s.clear.false_negatives, 0);
+  EXPECT_EQ(s.clear.id_switches, 0);
+  EXPECT_EQ(s.ignored_track_detections, 2 * kScans);
+  EXPECT_EQ(s.scored_tracks, 3);
+  EXPECT_NEAR(s.clear.mota, 1.0 - static_cast<double>(kScans) / (2 * kScans), 1e-12);
+  EXPECT_NEAR(s.clear.motp_m, (0.3 + 0.0) / 2.0, 1e-9);
+  // RMSE over the 2 * kScans matches: track 1 has errors (0.3 m, 2 deg, 0.5 m/s, 0.01 rad/s),
+  // track 2 none (its 180 deg flip is not a heading error, but is counted as a flip).
+  EXPECT_NEAR(s.position_rmse_m, std::sqrt(0.09 / 2.0), 1e-9);
+  EXPECT_NEAR(s.heading_rmse_deg, std::sqrt(4.0 / 2.0), 1e-6);
+  EXPECT_NEAR(s.heading_flip_fraction, 0.5, 1e-12);
+  EXPECT_NEAR(s.speed_rmse_mps, std::sqrt(0.25 / 2.0), 1e-9);
+  EXPECT_NEAR(s.yaw_rate_rmse_dps, 0.01 * 180.0 / kPi / std::sqrt(2.0), 1e-9);
+  // L: only track 1 (VASM) on the moving car A, 0.1 m off.
+  EXPECT_EQ(s.rear_axle_samples, kScans);
+  EXPECT_NEAR(s.rear_axle_rmse_m, 0.1, 1e-9);
+  // Prediction: 1 m off at every horizon, only where ground truth exists k seconds later
+  // (scans 0 .. kScans-1 at 10 Hz: kScans - 10 k of them); track 2 predicts nothing.
+  ASSERT_EQ(s.prediction_error_m.size(), 3u);
+  for (int k = 1; k <= 3; ++k) {
+    EXPECT_EQ(s.prediction_samples[k - 1], kScans - 10 * k) << k << " s";
+    EXPECT_NEAR(s.prediction_error_m[k - 1], 1.0, 1e-6) << k << " s";
+  }
+  // NEES: track 1 e = (0.3, 0, 2 deg) with P = diag(0.09, 0.01, (2 deg)^2) -> 2; track 2: 0.
+  EXPECT_EQ(s.nees_samples, 2 * kScans);
+  EXPECT_NEAR(s.nees_mean, 1.0, 1e-6);
+  EXPECT_NEAR(s.nees_within_95, 1.0, 1e-12);
+  // HOTA with a 2 m gate: track 1's S = 1 - 0.3/2 = 0.85 matches for the 17 thresholds up to 0.85
+  // (DetA = 2/3 with the false positive, AssA = 1); for 0.90 and 0.95 only B matches:
+  // TP = kScans, FN = kScans, FP = 2 kScans -> DetA = 1/4.
+  const double expected_hota = (17.0 * std::sqrt(2.0 / 3.0) + 2.0 * std::sqrt(0.25)) / 19.0;
+  EXPECT_NEAR(s.hota.hota, expected_hota, 1e-9);
+  // Per-track rows.
+  ASSERT_EQ(s.per_track.size(), 3u);
+  EXPECT_EQ(s.per_track[0].track_id, 1);
+  EXPECT_EQ(s.per_track[0].truth_id, 1);
+  EXPECT_EQ(s.per_track[0].matched, kScans);
+  EXPECT_NEAR(s.per_track[0].position_rmse_m, 0.3, 1e-9);
+  EXPECT_EQ(s.per_track[2].track_id, 7);
+  EXPECT_EQ(s.per_track[2].matched, 0);
+  EXPECT_EQ(s.per_track[2].truth_id, -1);
+}
+
+TEST_F(EvaluatorTest, RangeAndFieldOfViewRegion) {
+  // Ego at the origin heading +x. Within 15 m and +-60 deg: B at (10, -5) (27 deg) is in; A starts
+  // at (1.4, 0) and leaves the 15 m disc at some point of its circle; the false positive track 7 at
+  // (-20, 10) is outside the region, so it is dropped instead of counted.
+  EvalParams params;
+  params.region_range_m = 15.0;
+  params.region_fov_deg = 120.0;
+  const LogData data = LoadLogs({run_, tracks_}, params);
+  const EvalSummary s = Evaluate(data, params);
+  EXPECT_EQ(s.clear.false_positives, 0);
+  EXPECT_EQ(s.outside_region_track_detections, kScans);
+  // Count A's scans inside the region independently.
+  int a_inside = 0;
+  for (int k = 0; k < kScans; ++k) {
+    const auto a = vtrack::testing::CarA(k * 0.1);
+    if (a.centre.norm() <= 15.0 && std::abs(std::atan2(a.centre.y(), a.centre.x())) <= kPi / 3) ++a_inside;
+  }
+  ASSERT_GT(a_inside, 0);
+  ASSERT_LT(a_inside, kScans);
+  EXPECT_EQ(s.clear.gt_detections, kScans + a_inside);
+  EXPECT_EQ(s.clear.false_negatives, 0);
+}
+
+TEST_F(EvaluatorTest, CameraRegion) {
+  // A camera looking along the sensor's x axis with a +-45 deg horizontal view (f = cx = 500 px,
+  // width 1000): rect (x right, y down, z forward) from sensor (x forward, y left, z up).
+  CameraRegion cam;
+  Eigen::Matrix3d r;
+  r << 0, -1, 0, 0, 0, -1, 1, 0, 0;
+  cam.rect_from_sensor = Eigen::Affine3d::Identity();
+  cam.rect_from_sensor.linear() = r;
+  cam.P << 500, 0, 500, 0, 0, 500, 200, 0, 0, 0, 1, 0;
+  cam.width = 1000;
+  EXPECT_TRUE(cam.Contains({10.0, 0.0, -1.0}));
+  EXPECT_TRUE(cam.Contains({10.0, 9.9, -1.0}));    // 44.7 deg to the left
+  EXPECT_FALSE(cam.Contains({10.0, 10.1, -1.0}));  // 45.3 deg
+  EXPECT_FALSE(cam.Contains({10.0, -10.1, -1.0}));
+  EXPECT_FALSE(cam.Contains({-10.0, 0.0, -1.0}));  // behind
+  EvalParams params;
+  params.region_camera = cam;
+  const LogData data = LoadLogs({run_, tracks_}, params);
+  const EvalSummary s = Evaluate(data, params);
+  int a_inside = 0;
+  for (int k = 0; k < kScans; ++k) {
+    const auto a = vtrack::testing::CarA(k * 0.1);
+    if (a.centre.x() > 0 && std::abs(a.centre.y()) < a.centre.x()) ++a_inside;
+  }
+  EXPECT_EQ(s.clear.gt_detections, kScans + a_inside);  // B at 27 deg is always inside
+  EXPECT_EQ(s.outside_region_track_detections, kScans);  // track 7 is behind the camera
+}
+
+TEST_F(EvaluatorTest, ModesAndDuplicates) {
+  const std::string other = dir_ + "/tracks_ism.lcm";
+  vtrack::testing::WriteSyntheticTracks(other, "ism", 0.6);
+  EvalParams params;
+  const LogData data = LoadLogs({run_, tracks_, other}, params);
+  try {
+    Evaluate(data, params);
+    FAIL() << "several modes accepted without a choice";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("--mode"), std::string::npos) << e.what();
+  }
+  params.mode = "ism";
+  EXPECT_NEAR(Evaluate(data, params).clear.motp_m, 0.6 / 2.0, 1e-9);
+  params.mode = "vasm";
+  EXPECT_THROW(Evaluate(data, params), std::runtime_error);
+
+  // The same log twice: identical copies are skipped (and counted).
+  EvalParams p2;
+  const LogData twice = LoadLogs({run_, tracks_, tracks_}, p2);
+  EXPECT_EQ(Evaluate(twice, p2).clear.true_positives, 2 * kScans);
+  EXPECT_EQ(twice.problems.at("duplicate_identical_tracks"), kScans + 1);
+  // A different track list of the same mode and utime is an error that names the file.
+  const std::string changed = dir_ + "/tracks_changed.lcm";
+  vtrack::testing::WriteSyntheticTracks(changed, "mht", 0.4);
+  try {
+    LoadLogs({run_, tracks_, changed}, p2);
+    FAIL() << "conflicting track lists accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("tracks_changed.lcm"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace vtrack::eval

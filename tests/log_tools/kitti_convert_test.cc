@@ -1,0 +1,272 @@
+// vtrack-kitti2lcm: the conversion (library) on a synthetic sequence, the process's options and
+// errors, and the real sequence 0000 (skipped when ../shared/data is absent).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include "lcmtypes/util/decode.h"
+#include "lcmtypes/util/log_reader.h"
+#include "log_tools/kitti2lcm/converter.h"
+#include "sensor_driver/kitti/kitti_sequence.h"
+#include "tests/sensor_driver/kitti_synthetic.h"
+#include "tests/support/subprocess.h"
+#include "tests/support/test_env.h"
+#include "vtrack/ladar_scan_t.hpp"
+#include "vtrack/object_list_t.hpp"
+#include "vtrack/pose_t.hpp"
+
+namespace vtrack::kitti {
+namespace {
+
+namespace fs = std::filesystem;
+using vtrack::lcm_util::Decode;
+using vtrack::lcm_util::DecodeError;
+using vtrack::testing::BinDir;
+using vtrack::testing::ReadFile;
+using vtrack::testing::RunCommand;
+using vtrack::testing::ScratchDir;
+
+vtrack::testing::SyntheticSequence WriteSynthetic(const std::string& dir) {
+  vtrack::testing::SyntheticSequence s;
+  s.dir = dir;
+  s.num_frames = 6;
+  vtrack::testing::SyntheticObject car;
+  car.id = 4;
+  car.x0 = 15.0; car.y0 = 2.0; car.vx = 3.0;
+  s.objects = {car};
+  s.Write();
+  return s;
+}
+
+struct Event {
+  std::int64_t timestamp;
+  std::string channel;
+  std::int64_t utime;
+  std::int64_t seq = -1;  // scan seq / truth scan_seq
+};
+
+// Reads every event, decodes it with the checked decoder, and returns them in file order.
+std::vector<Event> ReadLog(const std::string& path) {
+  vtrack::lcm_util::LogReader reader(path);
+  std::vector<Event> events;
+  while (const lcm::LogEvent* ev = reader.Next()) {
+    Event e{ev->timestamp, ev->channel, 0};
+    if (e.channel == "LADAR_SCAN") {
+      vtrack::ladar_scan_t m;
+      EXPECT_EQ(Decode(ev->data, static_cast<std::size_t>(ev->datalen), &m), DecodeError::kNone);
+      e.utime = m.utime;
+      e.seq = m.seq;
+    } else if (e.channel == "EGO_POSE") {
+      vtrack::pose_t m;
+      EXPECT_EQ(Decode(ev->data, static_cast<std::size_t>(ev->datalen), &m), DecodeError::kNone);
+      e.utime = m.utime;
+    } else if (e.channel == "GROUND_TRUTH") {
+      vtrack::object_list_t m;
+      EXPECT_EQ(Decode(ev->data, static_cast<std::size_t>(ev->datalen), &m), DecodeError::kNone);
+      e.utime = m.utime;
+      e.seq = m.scan_seq;
+    } else {
+      ADD_FAILURE() << "unexpected channel " << e.channel;
+    }
+    events.push_back(e);
+  }
+  return events;
+}
+
+TEST(KittiConvertTest, SyntheticLogHasEveryChannelInTimeOrder) {
+  const std::string dir = ScratchDir("kitti_convert");
+  WriteSynthetic(dir);
+  SequenceOptions so;
+  so.dir = dir;
+  so.poses_file = dir + "/poses.txt";
+  so.sink = [](const std::string&) {};
+  const Sequence seq(so);
+  ConvertOptions co;
+  co.out = dir + "/out.lcm";
+  int progress_calls = 0;
+  const auto stats = ConvertSequence(seq, co, [&](int done, int total, std::int64_t) {
+    ++progress_calls;
+    EXPECT_EQ(total, 6);
+    EXPECT_EQ(done, progress_calls);
+  });
+  EXPECT_EQ(progress_calls, 6);
+  EXPECT_FALSE(fs::exists(co.out + ".partial"));
+  const auto events = ReadLog(co.out);
+
+  std::map<std::string, int> count;
+  for (const auto& e : events) ++count[e.channel];
+  // Poses every 10 ms over [start of sweep 0, end of sweep 5] = 600 ms: 61 poses.
+  EXPECT_EQ(count["EGO_POSE"], (seq.LastPoseUtime() - seq.FirstPoseUtime()) / 10'000 + 1);
+  EXPECT_EQ(count["EGO_POSE"], 61);
+  EXPECT_EQ(count["LADAR_SCAN"], 6);
+  EXPECT_EQ(count["GROUND_TRUTH"], 6);
+  EXPECT_EQ(stats.poses, 61);
+  EXPECT_EQ(stats.truth_objects, 6);
+
+  // Log timestamps are the messages' utimes, non-decreasing; pose before scan before truth at
+  // equal times; each truth follows its scan; each scan's sweep is covered by poses.
+  std::int64_t last_pose = -1;
+  for (std::size_t k = 0; k < events.size(); ++k) {
+    const Event& e = events[k];
+    EXPECT_EQ(e.timestamp, e.utime) << e.channel;
+    if (k > 0) {
+      EXPECT_GE(e.timestamp, events[k - 1].timestamp);
+    }
+    if (e.channel == "EGO_POSE") last_pose = e.utime;
+    if (e.channel == "LADAR_SCAN") {
+      EXPECT_EQ(last_pose, e.utime) << "no pose at the start of scan " << e.seq;
+      ASSERT_LT(k + 1, events.size());
+      EXPECT_EQ(events[k + 1].channel, "GROUND_TRUTH");
+      EXPECT_EQ(events[k + 1].seq, e.seq);
+      EXPECT_EQ(e.utime, seq.ScanUtime(static_cast<int>(e.seq)));
+    }
+  }
+  EXPECT_EQ(last_pose, seq.LastPoseUtime());
+}
+
+// At a rate whose period does not divide the frame period, every frame still has its own pose.
+TEST(KittiConvertTest, EveryFrameHasItsPoseAtAnyRate) {
+  const std::string dir = ScratchDir("kitti_convert_rate");
+  WriteSynthetic(dir);
+  SequenceOptions so;
+  so.dir = dir;
+  so.poses_file = dir + "/poses.txt";
+  so.sink = [](const std::string&) {};
+  const Sequence seq(so);
+  ConvertOptions co;
+  co.out = dir + "/out.lcm";
+  co.pose_period_us = 30'000;
+  co.first_frame = 1;
+  co.num_frames = 3;
+  co.ground_truth = false;
+  ConvertSequence(seq, co);
+  std::set<std::int64_t> pose_times;
+  int scans = 0, truths = 0;
+  for (const auto& e : ReadLog(co.out)) {
+    if (e.channel == "EGO_POSE") pose_times.insert(e.utime);
+    scans += e.channel == "LADAR_SCAN";
+    truths += e.channel == "GROUND_TRUTH";
+  }
+  EXPECT_EQ(scans, 3);
+  EXPECT_EQ(truths, 0);
+  for (int i = 1; i <= 3; ++i) EXPECT_TRUE(pose_times.count(seq.FrameUtime(i))) << "frame " << i;
+  EXPECT_EQ(*pose_times.begin(), seq.ScanUtime(1));
+  EXPECT_GE(*pose_times.rbegin(), seq.ScanUtime(3) + 90'000);
+
+  ConvertOptions bad = co;
+  bad.first_frame = 6;
+  EXPECT_THROW(ConvertSequence(seq, bad), KittiError);
+  bad = co;
+  bad.pose_period_us = 10;
+  EXPECT_NE(bad.Validate().find("pose_period_us"), std::string::npos);
+}
+
+std::string Tool() { return BinDir() + "/vtrack-kitti2lcm"; }
+
+// Runs the tool; returns (exit status, its output).
+std::pair<int, std::string> RunTool(const std::vector<std::string>& args, const std::string& scratch) {
+  std::vector<std::string> argv = {Tool()};
+  argv.insert(argv.end(), args.begin(), args.end());
+  const std::string log = scratch + "/tool_output.txt";
+  const int rc = RunCommand(argv, log);
+  return {rc, ReadFile(log)};
+}
+
+TEST(KittiConvertToolTest, HelpAndBadOptions) {
+  const std::string dir = ScratchDir("kitti_tool_opts");
+  WriteSynthetic(dir);
+  auto [rc, out] = RunTool({"--help"}, dir);
+  EXPECT_EQ(rc, 0);
+  for (const char* opt : {"--kitti", "--sequence", "--out", "--poses", "--oxts", "--cache-dir"}) {
+    EXPECT_NE(out.find(opt), std::string::npos) << opt;
+  }
+  std::tie(rc, out) = RunTool({"--kitti", dir}, dir);
+  EXPECT_EQ(rc, 2);
+  EXPECT_NE(out.find("out"), std::string::npos) << out;
+  std::tie(rc, out) = RunTool({"--kitti", dir, "--out", dir + "/x.lcm", "--pose-rate", "5"}, dir);
+  EXPECT_EQ(rc, 2);
+  EXPECT_NE(out.find("--pose-rate"), std::string::npos) << out;
+  std::tie(rc, out) = RunTool({"--kitti", dir, "--out", dir + "/x.lcm", "--bogus"}, dir);
+  EXPECT_EQ(rc, 2);
+  EXPECT_NE(out.find("bogus"), std::string::npos) << out;
+}
+
+TEST(KittiConvertToolTest, ClearErrorsForMissingAndBadData) {
+  const std::string dir = ScratchDir("kitti_tool_errors");
+  WriteSynthetic(dir);
+  const std::string out_file = dir + "/out.lcm";
+  auto [rc, out] = RunTool({"--kitti", dir + "/absent", "--out", out_file}, dir);
+  EXPECT_EQ(rc, 1);
+  EXPECT_NE(out.find(dir + "/absent does not exist"), std::string::npos) << out;
+  std::tie(rc, out) = RunTool({"--kitti", dir, "--sequence", "7", "--out", out_file, "--poses", dir + "/poses.txt"}, dir);
+  EXPECT_EQ(rc, 1);
+  EXPECT_NE(out.find("sequence 0007 not found"), std::string::npos) << out;
+  // A corrupt calibration value: the message names the file, the line and the value.
+  std::ofstream(dir + "/calib/0000.txt") << "P2: 700 0 600 0 0 700 170 0 0 0 1 0\nR0_rect: 1 0 0 0 1 0 0 0 one\n";
+  std::tie(rc, out) = RunTool({"--kitti", dir, "--out", out_file, "--poses", dir + "/poses.txt"}, dir);
+  EXPECT_EQ(rc, 1);
+  EXPECT_NE(out.find(dir + "/calib/0000.txt:2"), std::string::npos) << out;
+  EXPECT_NE(out.find("'one'"), std::string::npos) << out;
+  EXPECT_FALSE(fs::exists(out_file));
+  // An output folder that does not exist.
+  WriteSynthetic(dir);
+  std::tie(rc, out) = RunTool({"--kitti", dir, "--out", dir + "/no/such/dir/out.lcm", "--poses", dir + "/poses.txt"}, dir);
+  EXPECT_EQ(rc, 1);
+  EXPECT_NE(out.find(dir + "/no/such/dir/out.lcm"), std::string::npos) << out;
+  // And a good run, to be sure the errors above were about the data.
+  std::tie(rc, out) = RunTool({"--kitti", dir, "--out", out_file, "--poses", dir + "/poses.txt"}, dir);
+  EXPECT_EQ(rc, 0) << out;
+  EXPECT_NE(out.find("6 scans"), std::string::npos) << out;
+  EXPECT_TRUE(fs::exists(out_file));
+}
+
+// The real sequence: three frames through the process; the scans hold exactly the returns of the
+// .bin files (counted from their sizes), the truth lists hold the labelled objects.
+TEST(KittiConvertToolTest, RealSequenceFrames) {
+  const std::string kitti = vtrack::testing::KittiDir();
+  if (kitti.empty()) GTEST_SKIP() << "KITTI data not found (../shared/data/kitti_tracking_0000): skipped";
+  const std::string dir = ScratchDir("kitti_tool_real");
+  const std::string cache = BinDir() + "/../kitti_cache";
+  const std::string out_file = dir + "/kitti.lcm";
+  auto [rc, out] = RunTool({"--kitti", kitti, "--sequence", "0000", "--out", out_file, "--cache-dir", cache,
+                            "--first-frame", "10", "--num-frames", "3"}, dir);
+  ASSERT_EQ(rc, 0) << out;
+  EXPECT_NE(out.find("frame 3/3"), std::string::npos) << out;  // progress output
+
+  SequenceOptions so;
+  so.dir = kitti;
+  so.cache_dir = cache;
+  so.sink = [](const std::string&) {};
+  const Sequence seq(so);
+  vtrack::lcm_util::LogReader reader(out_file);
+  int scans = 0, poses = 0, truths = 0;
+  while (const lcm::LogEvent* ev = reader.Next()) {
+    if (ev->channel == "LADAR_SCAN") {
+      vtrack::ladar_scan_t m;
+      ASSERT_EQ(Decode(ev->data, static_cast<std::size_t>(ev->datalen), &m), DecodeError::kNone);
+      char name[32];
+      std::snprintf(name, sizeof(name), "/%06d.bin", static_cast<int>(m.seq));
+      const auto bytes = fs::file_size(seq.paths().velodyne_dir + name);
+      EXPECT_EQ(static_cast<std::uintmax_t>(m.npoints) * 16, bytes);
+      EXPECT_EQ(m.seq, 10 + scans);
+      ++scans;
+    } else if (ev->channel == "EGO_POSE") {
+      ++poses;
+    } else if (ev->channel == "GROUND_TRUTH") {
+      vtrack::object_list_t m;
+      ASSERT_EQ(Decode(ev->data, static_cast<std::size_t>(ev->datalen), &m), DecodeError::kNone);
+      EXPECT_GE(m.num_objects, 3);
+      for (const auto& o : m.objects) EXPECT_GT(o.num_points, 0) << "frame " << m.scan_seq << " id " << o.id;
+      ++truths;
+    }
+  }
+  EXPECT_EQ(scans, 3);
+  EXPECT_EQ(truths, 3);
+  EXPECT_EQ(poses, 31);  // 300 ms of sweeps at 100 Hz, both ends included
+}
+
+}  // namespace
+}  // namespace vtrack::kitti

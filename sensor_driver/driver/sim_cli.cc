@@ -1,0 +1,73 @@
+#include "sensor_driver/driver/sim_cli.h"
+
+#include <iostream>
+
+namespace vtrack::sim {
+
+namespace po = boost::program_options;
+
+void AddScenarioOptions(po::options_description* desc, bool start_utime_is_live) {
+  desc->add_options()
+      ("scenario", po::value<std::string>(),
+       "scenario NAME (config/scenarios/NAME.yaml) or path to a scenario file")
+      ("seed", po::value<std::uint64_t>(), "seed of every random draw (default: the scenario's)")
+      ("duration", po::value<double>(), "[s] override the scenario's duration (one run)")
+      ("start-utime", po::value<std::int64_t>(),
+       start_utime_is_live
+           ? "[us since epoch] start of run 0 (scenario t = 0); runs repeat every duration. "
+             "Default 0: runs on the wall-clock grid, so separately started processes agree"
+           : "[us since epoch] utime of scenario t = 0 (default: the scenario's start_utime)");
+}
+
+void AddSensorOptions(po::options_description* desc) {
+  desc->add_options()
+      ("sensor", po::value<std::string>(),
+       "sensor name: one of the scenario's `sensors` or a preset (single_plane, velodyne64)")
+      ("range-noise", po::value<double>(), "[m] override the sensor's 1-sigma range noise")
+      ("dropout", po::value<double>(), "[0,1) override the probability a return is lost")
+      ("spurious", po::value<double>(), "[0,1) override the probability of a spurious return per ray");
+}
+
+void AddPoseOptions(po::options_description* desc) {
+  desc->add_options()
+      ("pose-rate", po::value<double>(), "[Hz] EGO_POSE rate (default: the scenario's, 100)")
+      ("pose-noise-pos", po::value<double>(), "[m] 1-sigma Gauss-Markov noise on x and y")
+      ("pose-noise-yaw-deg", po::value<double>(), "[deg] 1-sigma Gauss-Markov noise on yaw");
+}
+
+SimCli ReadSimCli(const po::variables_map& vm) {
+  SimCli c;
+  auto get = [&](const char* k, auto* out) {
+    if (vm.count(k)) *out = vm[k].as<std::remove_reference_t<decltype(**out)>>();
+  };
+  if (vm.count("scenario")) c.scenario = vm["scenario"].as<std::string>();
+  get("duration", &c.duration);
+  get("start-utime", &c.start_utime);
+  get("seed", &c.run.seed);
+  if (vm.count("sensor")) c.run.sensor = vm["sensor"].as<std::string>();
+  get("range-noise", &c.run.range_noise);
+  get("dropout", &c.run.dropout);
+  get("spurious", &c.run.spurious);
+  get("pose-rate", &c.run.pose_rate_hz);
+  get("pose-noise-pos", &c.run.pose_noise_position);
+  get("pose-noise-yaw-deg", &c.run.pose_noise_yaw_deg);
+  return c;
+}
+
+std::unique_ptr<Simulator> MakeSimulator(const SimCli& cli) {
+  const std::string path = ResolveScenarioPath(cli.scenario);
+  return std::make_unique<Simulator>(LoadScenario(path, cli.duration), cli.run);
+}
+
+bool ParseCommandLine(int argc, char** argv, const po::options_description& desc,
+                      const std::string& usage, po::variables_map* vm) {
+  po::store(po::command_line_parser(argc, argv).options(desc).run(), *vm);
+  if (vm->count("help")) {
+    std::cout << usage << "\n\n" << desc << "\n";
+    return false;
+  }
+  po::notify(*vm);
+  return true;
+}
+
+}  // namespace vtrack::sim

@@ -1,0 +1,42 @@
+// Command-line options shared by vtrack-ladar-driver, vtrack-ego-pose and vtrack-sim-log, so the
+// three spell and check them the same way (and agree on a scenario's messages).
+#pragma once
+
+#include <boost/program_options.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "sensor_driver/sim/simulator.h"
+
+namespace vtrack::sim {
+
+struct SimCli {
+  std::string scenario;          // NAME or path
+  std::optional<double> duration;
+  std::optional<std::int64_t> start_utime;
+  RunOptions run;
+};
+
+// --scenario, --seed, --duration, --start-utime.
+void AddScenarioOptions(boost::program_options::options_description* desc, bool start_utime_is_live);
+// --sensor, --range-noise, --dropout, --spurious.
+void AddSensorOptions(boost::program_options::options_description* desc);
+// --pose-rate, --pose-noise-pos, --pose-noise-yaw-deg.
+void AddPoseOptions(boost::program_options::options_description* desc);
+
+// Reads the options above that were defined and given.
+SimCli ReadSimCli(const boost::program_options::variables_map& vm);
+
+// Resolves and loads the scenario and applies the overrides. Throws (ScenarioError,
+// std::invalid_argument) with a message fit for the user.
+std::unique_ptr<Simulator> MakeSimulator(const SimCli& cli);
+
+// Parses argv against desc; prints help (with usage) and returns false if --help was given.
+// Throws boost::program_options::error on bad options.
+bool ParseCommandLine(int argc, char** argv, const boost::program_options::options_description& desc,
+                      const std::string& usage, boost::program_options::variables_map* vm);
+
+}  // namespace vtrack::sim

@@ -1,0 +1,35 @@
+#include "sensor_driver/driver/timelines.h"
+
+namespace vtrack::sim {
+
+SimScanTimeline::SimScanTimeline(Simulator* sim, lcm::LCM* lcm, std::string scan_channel,
+                                 std::string truth_channel)
+    : sim_(sim), lcm_(lcm), scan_channel_(std::move(scan_channel)),
+      truth_channel_(std::move(truth_channel)) {}
+
+void SimScanTimeline::Prepare(int i, std::int64_t lap_start_utime, std::int64_t lap) {
+  sim_->MakeScan(i, lap_start_utime, lap * sim_->NumScans() + i, &scan_, &truth_);
+}
+
+void SimScanTimeline::Publish() {
+  if (lcm_->publish(scan_channel_, &scan_) < 0) {
+    log_.Warn("publish", "publishing " + scan_channel_ + " failed");
+  }
+  points_ += scan_.npoints;
+  if (!truth_channel_.empty() && lcm_->publish(truth_channel_, &truth_) < 0) {
+    log_.Warn("publish_truth", "publishing " + truth_channel_ + " failed");
+  }
+}
+
+SimPoseTimeline::SimPoseTimeline(Simulator* sim, lcm::LCM* lcm, std::string channel)
+    : sim_(sim), lcm_(lcm), channel_(std::move(channel)) {}
+
+void SimPoseTimeline::Prepare(int k, std::int64_t lap_start_utime, std::int64_t) {
+  sim_->MakePose(k, lap_start_utime, &pose_);
+}
+
+void SimPoseTimeline::Publish() {
+  if (lcm_->publish(channel_, &pose_) < 0) log_.Warn("publish", "publishing " + channel_ + " failed");
+}
+
+}  // namespace vtrack::sim

@@ -165,7 +165,9 @@ std::string UnpackVelodyneArchive(const std::string& archive, const std::string&
        << fs::last_write_time(archive_path).time_since_epoch().count();
     key = os.str();
   }
-  const fs::path cache_root = fs::path(cache_dir_in.empty() ? DefaultCacheDir() : cache_dir_in) / "kitti";
+  // lexically_normal: "build/bin/../kitti_cache" must not create build/bin on the way.
+  const fs::path cache_root =
+      (fs::path(cache_dir_in.empty() ? DefaultCacheDir() : cache_dir_in) / "kitti").lexically_normal();
   std::string stem = archive_path.filename().string();
   const fs::path final_dir = cache_root / (stem + "-" + key);
   const fs::path velodyne_dir = final_dir / "velodyne" / seq;

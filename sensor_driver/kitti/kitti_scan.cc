@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "tracker/core/angle.h"
@@ -17,28 +18,39 @@ std::string VelodyneParams::Validate() const {
   return os.str();
 }
 
-std::int32_t ReturnTimeUs(float x, float y, std::int32_t sweep_duration_us) {
-  if (!std::isfinite(x) || !std::isfinite(y)) return 0;
-  const double a = std::atan2(static_cast<double>(y), static_cast<double>(x));  // (-pi, pi]
-  double frac = (kPi - a) / (2.0 * kPi);                                        // [0, 1)
-  frac = std::clamp(frac, 0.0, 1.0);
-  const auto dt = static_cast<std::int32_t>(frac * sweep_duration_us);
-  return std::min(dt, sweep_duration_us - 1);
+
+namespace {
+
+// Azimuth atan2(y, x) of every return [rad]; NaN for a non-finite return.
+std::vector<double> Azimuths(const VelodyneFrame& frame) {
+  std::vector<double> az(frame.size());
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    az[i] = std::isfinite(frame.x[i]) && std::isfinite(frame.y[i])
+                ? std::atan2(static_cast<double>(frame.y[i]), static_cast<double>(frame.x[i]))
+                : std::numeric_limits<double>::quiet_NaN();
+  }
+  return az;
 }
 
-std::vector<std::int16_t> AssignRings(const VelodyneFrame& frame, int num_rings, int* found) {
+std::int32_t TimeOfAzimuth(double a, std::int32_t sweep_duration_us) {
+  if (!std::isfinite(a)) return 0;
+  const double frac = std::clamp((kPi - a) / (2.0 * kPi), 0.0, 1.0);  // [0, 1]
+  return std::min(static_cast<std::int32_t>(frac * sweep_duration_us), sweep_duration_us - 1);
+}
+
+std::vector<std::int16_t> RingsOfAzimuths(const std::vector<double>& azimuth, int num_rings, int* found) {
   // A laser contributes hundreds of returns to a sweep; a "laser" of fewer returns than this is a
   // stray return just past the forward crossing (seen in real KITTI files) and joins the previous.
   constexpr std::size_t kMinReturnsPerLaser = 16;
-  const std::size_t n = frame.size();
+  const std::size_t n = azimuth.size();
   std::vector<int> segment(n, -1);
   std::vector<std::size_t> segment_size;
   int seg = -1;
   double span = 0.0;       // [rad] azimuth covered by the current segment so far
   double prev_az = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
-    if (!std::isfinite(frame.x[i]) || !std::isfinite(frame.y[i])) continue;
-    const double az = std::atan2(static_cast<double>(frame.y[i]), static_cast<double>(frame.x[i]));
+    const double az = azimuth[i];
+    if (!std::isfinite(az)) continue;
     if (seg < 0 || (prev_az < 0.0 && az >= 0.0 && span > 1.5 * kPi)) {
       ++seg;
       span = 0.0;
@@ -70,6 +82,17 @@ std::vector<std::int16_t> AssignRings(const VelodyneFrame& frame, int num_rings,
   return ring;
 }
 
+}  // namespace
+
+std::int32_t ReturnTimeUs(float x, float y, std::int32_t sweep_duration_us) {
+  if (!std::isfinite(x) || !std::isfinite(y)) return 0;
+  return TimeOfAzimuth(std::atan2(static_cast<double>(y), static_cast<double>(x)), sweep_duration_us);
+}
+
+std::vector<std::int16_t> AssignRings(const VelodyneFrame& frame, int num_rings, int* found) {
+  return RingsOfAzimuths(Azimuths(frame), num_rings, found);
+}
+
 vtrack::ladar_scan_t MakeScan(const VelodyneFrame& frame, std::int64_t sweep_start_utime,
                               std::int64_t seq, const VelodyneParams& params) {
   vtrack::ladar_scan_t s;
@@ -88,11 +111,10 @@ vtrack::ladar_scan_t MakeScan(const VelodyneFrame& frame, std::int64_t sweep_sta
   s.y = frame.y;
   s.z = frame.z;
   s.intensity = frame.reflectance;
+  const std::vector<double> azimuth = Azimuths(frame);
   s.dt_us.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    s.dt_us[i] = ReturnTimeUs(frame.x[i], frame.y[i], params.sweep_duration_us);
-  }
-  s.ring = AssignRings(frame, params.num_rings);
+  for (std::size_t i = 0; i < n; ++i) s.dt_us[i] = TimeOfAzimuth(azimuth[i], params.sweep_duration_us);
+  s.ring = RingsOfAzimuths(azimuth, params.num_rings, nullptr);
   return s;
 }
 

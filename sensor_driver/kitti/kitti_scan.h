@@ -1,15 +1,17 @@
 // A KITTI Velodyne frame as a vtrack::ladar_scan_t: per-return time from the azimuth and the
 // laser index (ring) from the order of the returns in the file.
 //
-// Timing. KITTI triggers its cameras when the Velodyne faces forward, and a .bin file holds one
-// full revolution cut where the scanner faces backwards, so the frame's time (the labels' time,
-// the camera image) is the middle of the sweep. The HDL-64E spins clockwise seen from above, so
-// with azimuth a = atan2(y, x) in the velo frame (counter-clockwise from forward) a return was
-// measured
+// Timing. KITTI triggers its cameras when the Velodyne faces forward, between the start and the
+// end of the revolution that a .bin file holds, so the revolution is taken to be cut behind the
+// car and the frame's time (the labels' time, the camera image) to be the middle of the sweep.
+// The sensor is taken to spin clockwise seen from above (Velodyne's convention; KITTI documents
+// no direction and a look at the data did not settle it; inside the camera's view, +-41 deg,
+// either direction gives 50 +- 11 ms). With azimuth a = atan2(y, x) in the velo frame
+// (counter-clockwise from forward) a return was measured
 //     dt = ((pi - a) mod 2 pi) / (2 pi) * sweep_duration      after the sweep's start,
 // i.e. 0 behind, 1/4 sweep to the left, 1/2 sweep ahead, 3/4 to the right. The scan's utime is the
-// sweep's start: frame time - sweep_duration / 2. (KITTI gives no per-point times: this is the
-// nominal model, good to ~1 ms; the returns are not motion-compensated in the .bin files.)
+// sweep's start: frame time - sweep_duration / 2. KITTI gives no per-return times: this is a
+// nominal model. The returns are taken as not motion-compensated (as in KITTI raw data).
 //
 // Rings. A KITTI .bin stores the returns laser by laser, from the highest laser to the lowest,
 // each laser's returns in increasing azimuth from just left of forward round to just right of it.

@@ -1,0 +1,145 @@
+#include "tracker/core/shape.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+namespace vtrack {
+namespace {
+
+// A sample's weight halves every half-life: 2^(-t / half_life).
+TEST(Shape, WeightsDecayWithTheHalfLife) {
+  ShapeParams p;
+  p.half_life = 2.0;
+  DimensionHistogram hist(p);
+  EXPECT_EQ(hist.TotalWeight(0.0), 0.0);
+  ASSERT_TRUE(hist.Add(10.0, 4.0));
+  EXPECT_DOUBLE_EQ(hist.TotalWeight(10.0), 1.0);
+  EXPECT_DOUBLE_EQ(hist.TotalWeight(12.0), 0.5);
+  EXPECT_DOUBLE_EQ(hist.TotalWeight(16.0), 0.125);
+  ASSERT_TRUE(hist.Add(14.0, 4.0));  // the first now weighs 0.25
+  EXPECT_DOUBLE_EQ(hist.TotalWeight(14.0), 1.25);
+  ASSERT_TRUE(hist.Add(12.0, 4.0));  // an older sample arrives late: weight 0.5 at t = 14
+  EXPECT_DOUBLE_EQ(hist.TotalWeight(14.0), 1.75);
+}
+
+TEST(Shape, SingleValueIsItsOwnEstimate) {
+  DimensionHistogram hist;
+  EXPECT_FALSE(hist.Estimate().has_value());
+  for (int i = 0; i < 5; ++i) ASSERT_TRUE(hist.Add(0.1 * i, 4.53));
+  ASSERT_TRUE(hist.Estimate().has_value());
+  EXPECT_NEAR(*hist.Estimate(), 4.53, 0.01);
+}
+
+TEST(Shape, BadSamplesAreRefused) {
+  DimensionHistogram hist;
+  EXPECT_FALSE(hist.Add(0.0, std::nan("")));
+  EXPECT_FALSE(hist.Add(0.0, -1.0));
+  EXPECT_FALSE(hist.Add(0.0, 0.0));
+  EXPECT_FALSE(hist.Add(std::numeric_limits<double>::infinity(), 4.0));
+  EXPECT_EQ(hist.TotalWeight(0.0), 0.0);
+  EXPECT_FALSE(hist.Estimate().has_value());
+  // Above the range: counted (as an outlier), never an estimate.
+  EXPECT_TRUE(hist.Add(0.0, 1000.0));
+  EXPECT_EQ(hist.TotalWeight(0.0), 1.0);
+  EXPECT_FALSE(hist.Estimate().has_value());
+}
+
+// Paper Section 2.3: occluded views give shorter lengths. With 60% of the samples from occluded
+// views (a persistent partial occlusion that makes a strong peak at 2.2 m, and lengths spread
+// below the true one) and 3% gross outliers above, the estimate is the true length.
+TEST(Shape, TrueLengthDespiteSixtyPercentOccludedViews) {
+  const double true_length = 4.6;
+  for (std::uint64_t seed : {1, 2, 3, 4, 5}) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u01(0.0, 1.0);
+    std::normal_distribution<double> noise(0.0, 0.06);
+    std::uniform_real_distribution<double> shorter(1.0, true_length - 0.3);
+    std::uniform_real_distribution<double> gross(6.0, 15.0);
+    DimensionHistogram hist;
+    int occluded = 0;
+    const int n = 300;  // 30 s at 10 Hz; half-life 3 s
+    for (int i = 0; i < n; ++i) {
+      const double r = u01(rng);
+      double value;
+      if (r < 0.45) {
+        value = 2.2 + noise(rng);
+        ++occluded;
+      } else if (r < 0.60) {
+        value = shorter(rng);
+        ++occluded;
+      } else if (r < 0.97) {
+        value = true_length + noise(rng);
+      } else {
+        value = gross(rng);
+      }
+      ASSERT_TRUE(hist.Add(0.1 * i, value));
+    }
+    EXPECT_GT(occluded, 0.5 * n);  // the occluded views are the majority
+    ASSERT_TRUE(hist.Estimate().has_value());
+    EXPECT_NEAR(*hist.Estimate(), true_length, 0.05) << "seed " << seed;
+  }
+}
+
+// Estimate after a step change of the true size from `before` to `after` at t = 0, sampled at
+// 10 Hz with noise, `elapsed` seconds after the change.
+double AfterChange(double before, double after, double elapsed, const ShapeParams& p,
+                   std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  DimensionHistogram hist(p);
+  for (double t = -30.0; t < 1e-9; t += 0.1) hist.Add(t, before + noise(rng));
+  for (double t = 0.1; t <= elapsed + 1e-9; t += 0.1) hist.Add(t, after + noise(rng));
+  return *hist.Estimate();
+}
+
+// A size that grows (a vehicle first seen end-on) is followed within the half-life; one that
+// shrinks is followed after log2((1 + f) / f) half-lives (shape.h), not before, because a
+// shorter peak is indistinguishable from an occluded view.
+TEST(Shape, FollowsChangeOfTrueSizeWithinHalfLife) {
+  ShapeParams p;
+  p.half_life = 2.0;
+  EXPECT_NEAR(AfterChange(4.5, 5.6, p.half_life, p, 1), 5.6, 0.05);
+  EXPECT_NEAR(AfterChange(1.8, 4.5, p.half_life, p, 2), 4.5, 0.05);
+  // Before the change the old size holds.
+  EXPECT_NEAR(AfterChange(4.5, 5.6, 0.0, p, 3), 4.5, 0.05);
+
+  const double shrink_time =
+      p.half_life * std::log2((1.0 + p.min_peak_fraction) / p.min_peak_fraction);
+  EXPECT_NEAR(AfterChange(5.6, 4.5, 0.8 * shrink_time, p, 4), 5.6, 0.05);
+  EXPECT_NEAR(AfterChange(5.6, 4.5, 1.2 * shrink_time, p, 5), 4.5, 0.05);
+}
+
+TEST(Shape, LengthAndWidthAreSeparateAndSwap) {
+  ShapeEstimator shape;
+  for (int i = 0; i < 20; ++i) {
+    shape.AddLength(0.1 * i, 4.4);
+    shape.AddWidth(0.1 * i, 1.8);
+  }
+  EXPECT_NEAR(*shape.Length(), 4.4, 0.01);
+  EXPECT_NEAR(*shape.Width(), 1.8, 0.01);
+  shape.SwapLengthAndWidth();
+  EXPECT_NEAR(*shape.Length(), 1.8, 0.01);
+  EXPECT_NEAR(*shape.Width(), 4.4, 0.01);
+}
+
+TEST(Shape, ParamsValidationNamesFieldAndValue) {
+  std::string error;
+  EXPECT_TRUE(ShapeParams().Validate(&error)) << error;
+  ShapeParams p;
+  p.excluded_fraction = 1.5;
+  EXPECT_FALSE(p.Validate(&error));
+  EXPECT_NE(error.find("excluded_fraction = 1.5"), std::string::npos) << error;
+  p = ShapeParams();
+  p.half_life = 0.0;
+  EXPECT_FALSE(p.Validate(&error));
+  EXPECT_NE(error.find("half_life"), std::string::npos) << error;
+  p = ShapeParams();
+  p.bin_width = -0.1;
+  EXPECT_THROW(DimensionHistogram{p}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace vtrack

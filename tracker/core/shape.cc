@@ -1,0 +1,147 @@
+#include "tracker/core/shape.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "tracker/core/motion_model.h"
+
+namespace vtrack {
+
+bool ShapeParams::Validate(std::string* error) const {
+  using internal::CheckParam;
+  return CheckParam(std::isfinite(half_life) && half_life > 0.0, "ShapeParams", "half_life",
+                    half_life, "[s]", "finite and > 0", error) &&
+         CheckParam(std::isfinite(bin_width) && bin_width > 0.0, "ShapeParams", "bin_width",
+                    bin_width, "[m]", "finite and > 0", error) &&
+         CheckParam(std::isfinite(max_dimension) && max_dimension >= 2.0 * bin_width &&
+                        max_dimension <= 1e5 * bin_width,
+                    "ShapeParams", "max_dimension", max_dimension, "[m]",
+                    "finite and between 2 and 1e5 bin widths", error) &&
+         CheckParam(std::isfinite(excluded_fraction) && excluded_fraction >= 0.0 &&
+                        excluded_fraction < 1.0,
+                    "ShapeParams", "excluded_fraction", excluded_fraction, "[-]", "in [0, 1)",
+                    error) &&
+         CheckParam(std::isfinite(smoothing_std) && smoothing_std >= 0.0 &&
+                        smoothing_std <= 100.0 * bin_width,
+                    "ShapeParams", "smoothing_std", smoothing_std, "[m]",
+                    "finite and between 0 and 100 bin widths", error) &&
+         CheckParam(std::isfinite(min_peak_fraction) && min_peak_fraction > 0.0 &&
+                        min_peak_fraction <= 1.0,
+                    "ShapeParams", "min_peak_fraction", min_peak_fraction, "[-]", "in (0, 1]",
+                    error);
+}
+
+DimensionHistogram::DimensionHistogram(const ShapeParams& params) : params_(params) {
+  std::string error;
+  if (!params_.Validate(&error)) throw std::invalid_argument(error);
+  bins_.assign(static_cast<std::size_t>(std::ceil(params_.max_dimension / params_.bin_width)),
+               0.0);
+  const int half = static_cast<int>(std::ceil(3.0 * params_.smoothing_std / params_.bin_width));
+  kernel_.resize(2 * half + 1);
+  for (int k = -half; k <= half; ++k) {
+    const double d = k * params_.bin_width / std::max(params_.smoothing_std, 1e-300);
+    kernel_[k + half] = params_.smoothing_std > 0.0 ? std::exp(-0.5 * d * d) : 1.0;
+  }
+}
+
+bool DimensionHistogram::Add(double time_s, double value_m) {
+  if (!std::isfinite(time_s) || !std::isfinite(value_m) || value_m <= 0.0) return false;
+  double weight = 1.0;
+  if (empty_) {
+    newest_time_ = time_s;
+    empty_ = false;
+  } else if (time_s > newest_time_) {
+    // Decay everything to the new time: w *= 2^(-elapsed / half_life).
+    const double decay = std::exp2(-(time_s - newest_time_) / params_.half_life);
+    total_ *= decay;
+    overflow_ *= decay;
+    const double negligible = 1e-15 * total_;  // keeps long-gone bins out of denormal range
+    for (double& b : bins_) {
+      b *= decay;
+      if (b < negligible) b = 0.0;
+    }
+    newest_time_ = time_s;
+  } else {
+    weight = std::exp2(-(newest_time_ - time_s) / params_.half_life);
+  }
+  if (value_m > params_.max_dimension) {
+    overflow_ += weight;
+  } else {
+    // Linear binning: the weight is shared between the two bins whose centres enclose the value,
+    // so a peak's position is resolved below the bin width (the parabola in Estimate() finds it).
+    const double last = static_cast<double>(bins_.size() - 1);
+    const double pos = std::clamp(value_m / params_.bin_width - 0.5, 0.0, last);
+    const double lower = std::floor(pos);
+    const double frac = pos - lower;
+    const auto i = static_cast<std::size_t>(lower);
+    bins_[i] += weight * (1.0 - frac);
+    if (frac > 0.0) bins_[i + 1] += weight * frac;
+  }
+  total_ += weight;
+  return true;
+}
+
+double DimensionHistogram::TotalWeight(double time_s) const {
+  if (empty_) return 0.0;
+  return total_ * std::exp2(-std::max(0.0, time_s - newest_time_) / params_.half_life);
+}
+
+std::optional<double> DimensionHistogram::Estimate() const {
+  if (empty_ || total_ <= 0.0) return std::nullopt;
+  const int n = static_cast<int>(bins_.size());
+  const double bw = params_.bin_width;
+
+  // 1. The (1 - excluded_fraction) weighted quantile, weight spread evenly within a bin.
+  double cutoff = params_.max_dimension;
+  {
+    const double excluded = params_.excluded_fraction * total_;
+    double above = overflow_;
+    for (int i = n - 1; i >= 0 && above < excluded; --i) {
+      if (above + bins_[i] >= excluded) {
+        cutoff = (i + 1.0 - (excluded - above) / bins_[i]) * bw;
+      }
+      above += bins_[i];
+    }
+  }
+
+  // 2. Smoothed histogram.
+  const int half = static_cast<int>(kernel_.size() / 2);
+  std::vector<double> s(n, 0.0);
+  for (int i = 0; i < n; ++i) {
+    if (bins_[i] == 0.0) continue;
+    const int k0 = std::max(-half, -i), k1 = std::min(half, n - 1 - i);
+    for (int k = k0; k <= k1; ++k) s[i + k] += bins_[i] * kernel_[k + half];
+  }
+
+  // 3. Eligible local maxima (centre at or below the cutoff), the highest of them, then the
+  // longest one of at least min_peak_fraction of that height.
+  auto is_peak = [&](int i) {
+    return s[i] > 0.0 && (i == 0 || s[i] > s[i - 1]) && (i == n - 1 || s[i] >= s[i + 1]) &&
+           (i + 0.5) * bw <= cutoff;
+  };
+  double highest = 0.0;
+  for (int i = 0; i < n; ++i) {
+    if (is_peak(i)) highest = std::max(highest, s[i]);
+  }
+  if (highest <= 0.0) {
+    // Every sample lies in the excluded top or above the range: nothing to choose from.
+    return std::nullopt;
+  }
+  int chosen = -1;
+  for (int i = n - 1; i >= 0 && chosen < 0; --i) {
+    if (is_peak(i) && s[i] >= params_.min_peak_fraction * highest) chosen = i;
+  }
+
+  // Vertex of the parabola through the chosen bin and its neighbours, within half a bin.
+  double offset = 0.0;
+  if (chosen > 0 && chosen < n - 1) {
+    const double curvature = s[chosen - 1] - 2.0 * s[chosen] + s[chosen + 1];
+    if (curvature < 0.0) {
+      offset = std::clamp(0.5 * (s[chosen - 1] - s[chosen + 1]) / curvature, -0.5, 0.5);
+    }
+  }
+  return (chosen + 0.5 + offset) * bw;
+}
+
+}  // namespace vtrack

@@ -1,0 +1,96 @@
+// The vehicle shape model, paper Section 2.3 and DESIGN note 8: the length and the width of the
+// vehicle rectangle, each estimated from a histogram of its measurements.
+//
+// Each measurement adds its weight to the histogram (shared between the two nearest bins);
+// weights decay exponentially, halving every half_life seconds, so the estimate follows a vehicle whose size was misjudged at first (the
+// paper's "normalisation determines the half-life"). From the histogram:
+//  1. Outliers: the largest excluded_fraction (5%) of the weight is excluded: peaks above the
+//     (1 - excluded_fraction) weighted quantile cannot be chosen. (The excluded samples still
+//     shape the histogram; removing them instead would cut the upper flank of the true peak and
+//     bias it short.)
+//  2. Peaks: the histogram is smoothed with a Gaussian kernel (smoothing_std, about the noise of
+//     one dimension measurement) and its local maxima are found. A peak counts if its height is
+//     at least min_peak_fraction of the highest eligible peak: without this, any small bump of
+//     noise would be a "peak". (The paper leaves what a peak is open.)
+//  3. Occlusion: partial views only ever give shorter lengths, so among the counted peaks the one
+//     of greatest length is the estimate (refined by a parabola through the smoothed bins).
+// Consequences of the longest-peak rule, by design: a size that grows is followed as soon as its
+// peak reaches min_peak_fraction of the old one (for a steady stream of samples after
+// half_life * log2(1 + min_peak_fraction), 0.32 half-lives at the default); a size that shrinks
+// is followed only when the old peak has decayed below min_peak_fraction of the new one, after
+// half_life * log2((1 + f) / f) (2.3 half-lives at f = 0.25), since a shorter peak looks just
+// like an occluded view.
+#pragma once
+
+#include <optional>
+#include <utility>
+#include <string>
+#include <vector>
+
+namespace vtrack {
+
+struct ShapeParams {
+  double half_life = 3.0;           // [s] a sample's weight halves every half_life
+  double bin_width = 0.05;          // [m] histogram bin width
+  double max_dimension = 20.0;      // [m] histogram range (0, max]; larger samples count as
+                                    // outliers above the range (they are never a peak)
+  double excluded_fraction = 0.05;  // [-] top fraction of the weight excluded as outliers
+  double smoothing_std = 0.15;      // [m] std of the Gaussian kernel smoothing the histogram
+  double min_peak_fraction = 0.25;  // [-] least height of a peak relative to the highest one
+
+  bool Validate(std::string* error) const;
+};
+
+// The decaying histogram of one dimension (length or width).
+class DimensionHistogram {
+ public:
+  // Throws std::invalid_argument with the Validate() message if params are invalid.
+  explicit DimensionHistogram(const ShapeParams& params = ShapeParams());
+
+  // Adds a measurement value_m [m] taken at time_s [s]. A sample older than the newest one adds
+  // its already-decayed weight. Returns false, leaving the histogram unchanged, if a value is
+  // not finite or value_m <= 0.
+  bool Add(double time_s, double value_m);
+
+  // The length of the longest counted peak [m]; empty before any sample.
+  std::optional<double> Estimate() const;
+
+  // Sum of the sample weights, decayed to time_s [s] (>= the newest sample's time); 0 if empty.
+  double TotalWeight(double time_s) const;
+
+  const ShapeParams& params() const { return params_; }
+
+ private:
+  ShapeParams params_;
+  std::vector<double> bins_;    // decayed weights, bin i centred at (i + 1/2) * bin_width
+  std::vector<double> kernel_;  // smoothing kernel, kernel_[k] for offsets -K..K
+  double overflow_ = 0.0;       // decayed weight of samples above max_dimension
+  double total_ = 0.0;          // decayed weight of all samples
+  double newest_time_ = 0.0;    // [s] time the weights are decayed to
+  bool empty_ = true;
+};
+
+// Length and width of one tracked object.
+class ShapeEstimator {
+ public:
+  explicit ShapeEstimator(const ShapeParams& params = ShapeParams())
+      : length_(params), width_(params) {}
+
+  bool AddLength(double time_s, double length_m) { return length_.Add(time_s, length_m); }
+  bool AddWidth(double time_s, double width_m) { return width_.Add(time_s, width_m); }
+  std::optional<double> Length() const { return length_.Estimate(); }
+  std::optional<double> Width() const { return width_.Estimate(); }
+
+  // Exchanges the length and width histograms: for a hypothesis whose orientation is turned by
+  // 90 deg (Ekf::Convert with heading_offset pi/2).
+  void SwapLengthAndWidth() { std::swap(length_, width_); }
+
+  const DimensionHistogram& length_histogram() const { return length_; }
+  const DimensionHistogram& width_histogram() const { return width_; }
+
+ private:
+  DimensionHistogram length_;
+  DimensionHistogram width_;
+};
+
+}  // namespace vtrack

@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <unordered_map>
 
 #include "log_tools/eval/gated_assignment.h"
 
@@ -191,20 +192,46 @@ HotaResult ComputeHota(const std::vector<ScoringFrame>& frames, const HotaParams
   HotaResult r;
   for (int k = 1; k <= 19; ++k) r.alphas.push_back(0.05 * k);
 
-  // Similarity of every pair in every frame, and how many frames each id is present in.
-  std::vector<Eigen::MatrixXd> sim(frames.size());
-  std::map<std::int64_t, double> gt_count, tr_count;
+  // Dense indices of truth ids, track ids and of the (truth, track) pairs that ever have S > 0.
+  std::unordered_map<std::int64_t, int> gt_index, tr_index;
+  std::unordered_map<std::int64_t, int> pair_index;  // gt dense * (1 << 32) + track dense
+  std::vector<double> gt_count, tr_count;            // frames each id is present in
+  struct Candidate {
+    int i, j, pair;
+    double s;
+  };
+  std::vector<std::vector<Candidate>> candidates(frames.size());
   for (std::size_t t = 0; t < frames.size(); ++t) {
     const ScoringFrame& f = frames[t];
     CheckFrame(f);
-    sim[t].resize(f.gt_ids.size(), f.track_ids.size());
+    std::vector<int> gd(f.gt_ids.size()), td(f.track_ids.size());
+    for (std::size_t i = 0; i < f.gt_ids.size(); ++i) {
+      const auto [it, added] = gt_index.emplace(f.gt_ids[i], static_cast<int>(gt_count.size()));
+      if (added) gt_count.push_back(0.0);
+      gd[i] = it->second;
+      gt_count[gd[i]] += 1.0;
+    }
+    for (std::size_t j = 0; j < f.track_ids.size(); ++j) {
+      const auto [it, added] = tr_index.emplace(f.track_ids[j], static_cast<int>(tr_count.size()));
+      if (added) tr_count.push_back(0.0);
+      td[j] = it->second;
+      tr_count[td[j]] += 1.0;
+    }
     for (std::size_t i = 0; i < f.gt_ids.size(); ++i) {
       for (std::size_t j = 0; j < f.track_ids.size(); ++j) {
-        sim[t](i, j) = HotaSimilarity((f.gt_xy[i] - f.track_xy[j]).norm(), params.similarity_gate_m);
+        const double s = HotaSimilarity((f.gt_xy[i] - f.track_xy[j]).norm(), params.similarity_gate_m);
+        if (s <= 0.0) continue;
+        const std::int64_t key = (static_cast<std::int64_t>(gd[i]) << 32) + td[j];
+        const auto [it, added] = pair_index.emplace(key, static_cast<int>(pair_index.size()));
+        candidates[t].push_back({static_cast<int>(i), static_cast<int>(j), it->second, s});
       }
     }
-    for (const auto id : f.gt_ids) gt_count[id] += 1.0;
-    for (const auto id : f.track_ids) tr_count[id] += 1.0;
+  }
+  // The truth and track of each pair, by dense index.
+  std::vector<int> pair_gt(pair_index.size()), pair_tr(pair_index.size());
+  for (const auto& [key, p] : pair_index) {
+    pair_gt[p] = static_cast<int>(key >> 32);
+    pair_tr[p] = static_cast<int>(key & 0xffffffff);
   }
 
   // Lexicographic matching score (Sec. 5): number of pairs >> A_max >> S.
@@ -214,38 +241,33 @@ HotaResult ComputeHota(const std::vector<ScoringFrame>& frames, const HotaParams
   constexpr double kAlphaTolerance = 1e-9;
 
   for (const double alpha : r.alphas) {
-    using Pair = std::pair<std::int64_t, std::int64_t>;
-    std::map<Pair, double> potential;  // frames in which S >= alpha, per (truth, track)
-    for (std::size_t t = 0; t < frames.size(); ++t) {
-      const ScoringFrame& f = frames[t];
-      for (std::size_t i = 0; i < f.gt_ids.size(); ++i) {
-        for (std::size_t j = 0; j < f.track_ids.size(); ++j) {
-          if (sim[t](i, j) >= alpha - kAlphaTolerance) potential[{f.gt_ids[i], f.track_ids[j]}] += 1.0;
-        }
+    std::vector<double> potential(pair_index.size(), 0.0);  // frames with S >= alpha, per pair
+    for (const auto& frame : candidates) {
+      for (const Candidate& c : frame) {
+        if (c.s >= alpha - kAlphaTolerance) potential[c.pair] += 1.0;
       }
     }
-    std::map<Pair, double> tpa;  // TPs per (truth, track)
+    std::vector<double> tpa(pair_index.size(), 0.0);  // TPs per pair
     double tp = 0.0, fn = 0.0, fp = 0.0, loc_sum = 0.0;
     for (std::size_t t = 0; t < frames.size(); ++t) {
       const ScoringFrame& f = frames[t];
-      Eigen::MatrixXd cost(f.gt_ids.size(), f.track_ids.size());
-      for (std::size_t i = 0; i < f.gt_ids.size(); ++i) {
-        for (std::size_t j = 0; j < f.track_ids.size(); ++j) {
-          const double s = sim[t](i, j);
-          if (s < alpha - kAlphaTolerance || s <= 0.0) {
-            cost(i, j) = std::numeric_limits<double>::infinity();
-            continue;
-          }
-          const Pair p{f.gt_ids[i], f.track_ids[j]};
-          const double n = potential[p];
-          const double a_max = n / (gt_count[p.first] + tr_count[p.second] - n);
-          cost(i, j) = -(kPairWeight + a_max + kSimilarityWeight * s);
-        }
+      Eigen::MatrixXd cost = Eigen::MatrixXd::Constant(
+          static_cast<Eigen::Index>(f.gt_ids.size()), static_cast<Eigen::Index>(f.track_ids.size()),
+          std::numeric_limits<double>::infinity());
+      Eigen::MatrixXi which = Eigen::MatrixXi::Constant(cost.rows(), cost.cols(), -1);
+      Eigen::MatrixXd sim = Eigen::MatrixXd::Zero(cost.rows(), cost.cols());
+      for (const Candidate& c : candidates[t]) {
+        if (c.s < alpha - kAlphaTolerance) continue;
+        const double n = potential[c.pair];
+        const double a_max = n / (gt_count[pair_gt[c.pair]] + tr_count[pair_tr[c.pair]] - n);
+        cost(c.i, c.j) = -(kPairWeight + a_max + kSimilarityWeight * c.s);
+        which(c.i, c.j) = c.pair;
+        sim(c.i, c.j) = c.s;
       }
       const auto pairs = GatedAssignment(cost);
       for (const auto& [i, j] : pairs) {
-        tpa[{f.gt_ids[i], f.track_ids[j]}] += 1.0;
-        loc_sum += sim[t](i, j);
+        tpa[which(i, j)] += 1.0;
+        loc_sum += sim(i, j);
       }
       tp += static_cast<double>(pairs.size());
       fn += static_cast<double>(f.gt_ids.size() - pairs.size());
@@ -253,8 +275,8 @@ HotaResult ComputeHota(const std::vector<ScoringFrame>& frames, const HotaParams
     }
     // sum over TPs of A(c) = sum over pairs of TPA * A(pair).
     double ass_sum = 0.0;
-    for (const auto& [p, n] : tpa) {
-      ass_sum += n * n / (gt_count[p.first] + tr_count[p.second] - n);
+    for (std::size_t p = 0; p < tpa.size(); ++p) {
+      if (tpa[p] > 0.0) ass_sum += tpa[p] * tpa[p] / (gt_count[pair_gt[p]] + tr_count[pair_tr[p]] - tpa[p]);
     }
     const double denom = tp + fn + fp;
     const double deta = denom > 0.0 ? tp / denom : kNaN;

@@ -235,8 +235,8 @@ int RunCompare(const CompareOptions& o) {
     LogData base;
     try {
       Progress progress(!o.quiet);
-      base = LoadLogs({run}, params, [&](const std::string&, double f) {
-        progress.Update("reading " + item.name + "/run.lcm", f);
+      base = LoadLogs({run}, params, [&](const std::string& path, double f) {
+        if (WorthProgress(path)) progress.Update("reading " + item.name + "/run.lcm", f);
       });
     } catch (const std::exception& e) {
       failures.push_back(item.name + ": " + e.what());

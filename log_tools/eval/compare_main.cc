@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "log_tools/eval/compare.h"
+#include "sensor_driver/kitti/kitti_layout.h"
 
 namespace po = boost::program_options;
 using namespace vtrack::eval;
@@ -69,6 +70,13 @@ int main(int argc, char** argv) {
     if (!o.eval.mode.empty()) throw std::invalid_argument("--mode is not an option here: use --modes");
     if (o.reuse && o.work_dir.empty()) throw std::invalid_argument("--reuse needs --work-dir");
     for (const auto& s : SplitList(scenarios)) o.items.push_back(ScenarioItem(s));
+    if (!kitti_dirs.empty()) {
+      try {
+        o.kitti_sequence = vtrack::kitti::NormaliseSequence(o.kitti_sequence);
+      } catch (const std::exception& e) {
+        throw std::invalid_argument(std::string("--kitti-sequence: ") + e.what());
+      }
+    }
     for (const auto& d : kitti_dirs) {
       CompareItem item;
       item.kind = CompareItem::Kind::kKitti;

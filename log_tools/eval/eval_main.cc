@@ -73,7 +73,9 @@ int main(int argc, char** argv) {
   try {
     Progress progress(!quiet);
     const LogData data = LoadLogs(logs, params, [&](const std::string& path, double f) {
-      progress.Update("reading " + std::filesystem::path(path).filename().string(), f);
+      if (WorthProgress(path)) {
+        progress.Update("reading " + std::filesystem::path(path).filename().string(), f);
+      }
     });
     progress.Finish();
     const EvalSummary summary = Evaluate(data, params);

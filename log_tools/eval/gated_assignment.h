@@ -7,7 +7,9 @@
 // Hungarian step. It is solved exactly with the project's Hungarian solver
 // (vtrack::SolveAssignment, tracker/core/association.h): forbidden pairs get a cost larger
 // than any sum of allowed costs, so that the solver's complete assignment uses as few of them as
-// possible, and those are then dropped.
+// possible, and those are then dropped. The problem is split into the connected components of
+// the allowed pairs first (the optimum decomposes over them), so that the cubic cost of the
+// Hungarian method applies only to groups of nearby objects.
 #pragma once
 
 #include <Eigen/Core>

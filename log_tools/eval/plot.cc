@@ -60,6 +60,14 @@ void DrawPanel(cv::Mat& img, const Panel& panel, const cv::Rect& area) {
     x0 -= 0.5;
     x1 += 0.5;
   }
+  // Room for markers at the ends of the x range.
+  const bool markers = std::any_of(panel.series.begin(), panel.series.end(),
+                                   [](const Series& s) { return s.markers; });
+  if (markers) {
+    const double xpad = 0.04 * (x1 - x0);
+    x0 -= xpad;
+    x1 += xpad;
+  }
   if (y1 - y0 < 1e-12) {
     y0 -= 0.5;
     y1 += 0.5;
@@ -154,7 +162,7 @@ void DrawPanel(cv::Mat& img, const Panel& panel, const cv::Rect& area) {
   cv::rectangle(img, box, kAxis, 1);
   for (std::size_t i = 0; i < named.size(); ++i) {
     const int y = box.y + 4 + row * static_cast<int>(i) + row / 2;
-    cv::line(img, {box.x + 6, y}, {box.x + 26, y}, named[i]->color, 2, cv::LINE_AA);
+    if (named[i]->line) cv::line(img, {box.x + 6, y}, {box.x + 26, y}, named[i]->color, 2, cv::LINE_AA);
     if (named[i]->markers) cv::circle(img, {box.x + 16, y}, 3, named[i]->color, cv::FILLED);
     PutText(img, named[i]->name, {box.x + 32, y + 5}, 0.4);
   }

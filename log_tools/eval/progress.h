@@ -4,10 +4,21 @@
 
 #include <unistd.h>
 
+#include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 namespace vtrack::eval {
+
+// Logs smaller than this are read in a moment: no progress output for them.
+inline constexpr std::uintmax_t kProgressMinBytes = 32u << 20;
+
+inline bool WorthProgress(const std::string& path) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  return !ec && size >= kProgressMinBytes;
+}
 
 class Progress {
  public:

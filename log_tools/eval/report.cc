@@ -160,7 +160,9 @@ std::string ComparisonTable(const std::vector<TableRow>& rows) {
   cells.push_back(head);
   for (const auto& r : rows) {
     std::vector<std::string> line = {r.item, r.mode};
-    for (const auto& c : cols) line.push_back(r.summary ? c.value(*r.summary) : "failed");
+    for (std::size_t k = 0; k < cols.size(); ++k) {
+      line.push_back(r.summary ? cols[k].value(*r.summary) : (k == 0 ? "failed" : "-"));
+    }
     cells.push_back(line);
   }
   std::vector<std::size_t> width(head.size(), 0);

@@ -73,7 +73,7 @@ int RunLog(const std::string& path, const std::string& channels, int width) {
   int last_percent = -1;
   while (const lcm::LogEvent* ev = reader.Next()) {
     if (!std::regex_match(ev->channel, re)) continue;
-    if (first < 0) first = ev->timestamp;
+    first = first < 0 ? ev->timestamp : std::min<std::int64_t>(first, ev->timestamp);
     last = std::max<std::int64_t>(last, ev->timestamp);
     table.Add(ev->channel, ev->timestamp, ev->data,
               static_cast<std::size_t>(std::max<std::int32_t>(ev->datalen, 0)));

@@ -1,0 +1,166 @@
+#include "viewer/msg_convert.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace vtrack::viewer {
+namespace {
+
+// A quaternion (w, x, y, z) close to unit length, normalised; nullopt otherwise.
+std::optional<Eigen::Quaterniond> UnitQuaternion(const double q[4], const char* what,
+                                                 std::string* why) {
+  const Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
+  const double norm = quat.norm();
+  if (!std::isfinite(norm) || norm < 0.9 || norm > 1.1) {
+    if (why) {
+      std::ostringstream os;
+      os << what << " quaternion (" << q[0] << ", " << q[1] << ", " << q[2] << ", " << q[3]
+         << ") is not a unit quaternion (norm " << norm << ")";
+      *why = os.str();
+    }
+    return std::nullopt;
+  }
+  return quat.normalized();
+}
+
+Eigen::Matrix3d RowMajor3(const double m[9]) {
+  return Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(m);
+}
+
+OrientedBox MakeBox(double x, double y, double theta, double length, double width) {
+  OrientedBox b;
+  b.center = {x, y};
+  b.theta = theta;
+  b.length = length;
+  b.width = width;
+  return b;
+}
+
+bool PositiveFinite(double v) { return std::isfinite(v) && v > 0.0; }
+
+}  // namespace
+
+std::optional<Eigen::Isometry3d> PoseFromMsg(const vtrack::pose_t& msg, std::string* why) {
+  const Eigen::Vector3d pos(msg.pos[0], msg.pos[1], msg.pos[2]);
+  if (!pos.allFinite()) {
+    if (why) *why = "pose position is not finite";
+    return std::nullopt;
+  }
+  const auto q = UnitQuaternion(msg.orientation, "pose orientation", why);
+  if (!q) return std::nullopt;
+  Eigen::Isometry3d world_from_body = Eigen::Isometry3d::Identity();
+  world_from_body.linear() = q->toRotationMatrix();
+  world_from_body.translation() = pos;
+  return world_from_body;
+}
+
+std::optional<LadarScan> ScanFromMsg(const vtrack::ladar_scan_t& msg, std::string* why) {
+  const Eigen::Vector3d pos(msg.sensor_pos[0], msg.sensor_pos[1], msg.sensor_pos[2]);
+  if (!pos.allFinite()) {
+    if (why) *why = "scan sensor_pos is not finite";
+    return std::nullopt;
+  }
+  const auto q = UnitQuaternion(msg.sensor_orientation, "scan sensor_orientation", why);
+  if (!q) return std::nullopt;
+  LadarScan scan;
+  scan.utime = msg.utime;
+  scan.seq = msg.seq;
+  scan.sensor_id = msg.sensor_id;
+  scan.body_from_sensor.linear() = q->toRotationMatrix();
+  scan.body_from_sensor.translation() = pos;
+  scan.sweep_duration_us = msg.sweep_duration_us;
+  scan.max_range = msg.max_range;
+  scan.num_rings = msg.num_rings;
+  scan.x = msg.x;
+  scan.y = msg.y;
+  scan.z = msg.z;
+  scan.intensity = msg.intensity;
+  scan.dt_us = msg.dt_us;
+  scan.ring = msg.ring;
+  return scan;
+}
+
+SceneTrack TrackFromMsg(const vtrack::track_t& msg) {
+  SceneTrack t;
+  t.id = msg.id;
+  t.status = msg.status == vtrack::track_t::STATUS_TENTATIVE ? TrackStatus::kTentative
+             : msg.status == vtrack::track_t::STATUS_COASTING ? TrackStatus::kCoasting
+                                                              : TrackStatus::kConfirmed;
+  t.model = msg.model == vtrack::track_t::MODEL_VASM ? MotionModel::kVasm : MotionModel::kIsm;
+  t.moving = msg.moving;
+  t.object_class = msg.object_class == vtrack::track_t::CLASS_VEHICLE ? TrackClass::kVehicle
+                   : msg.object_class == vtrack::track_t::CLASS_OTHER ? TrackClass::kOther
+                                                                      : TrackClass::kUnknown;
+  t.box = MakeBox(msg.x, msg.y, msg.theta, msg.length, msg.width);
+  t.cov = RowMajor3(msg.cov);
+  t.speed = msg.speed;
+  t.velocity_heading = msg.velocity_heading;
+  t.yaw_rate = msg.yaw_rate;
+  t.rear_axle_offset = msg.rear_axle_offset;
+  t.num_hypotheses = msg.num_hypotheses;
+  const std::size_t n = std::min(msg.pred_x.size(), msg.pred_y.size());
+  t.predicted.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) t.predicted.emplace_back(msg.pred_x[i], msg.pred_y[i]);
+  return t;
+}
+
+SceneMeasurement MeasurementFromMsg(const vtrack::track_debug_entry_t& msg,
+                                    const SceneTrack* track) {
+  SceneMeasurement m;
+  m.track_id = msg.track_id;
+  m.fit_kind = msg.fit_kind == vtrack::track_debug_entry_t::FIT_CORNER ? FitKind::kCorner
+               : msg.fit_kind == vtrack::track_debug_entry_t::FIT_EDGE ? FitKind::kEdge
+                                                                        : FitKind::kNone;
+  double length = msg.predicted[3], width = msg.predicted[4];
+  if (!PositiveFinite(length) || !PositiveFinite(width)) {
+    length = msg.updated[3];
+    width = msg.updated[4];
+  }
+  if ((!PositiveFinite(length) || !PositiveFinite(width)) && track) {
+    length = track->box.length;
+    width = track->box.width;
+  }
+  m.z_box = MakeBox(msg.z[0], msg.z[1], msg.z[2], length, width);
+  m.R = RowMajor3(msg.R);
+  m.visible_faces = static_cast<std::uint8_t>(msg.visible_faces);
+  const std::size_t ne = std::min({msg.edge_x0.size(), msg.edge_y0.size(), msg.edge_x1.size(),
+                                   msg.edge_y1.size()});
+  for (std::size_t i = 0; i < ne; ++i) {
+    m.edges.emplace_back(Eigen::Vector2d(msg.edge_x0[i], msg.edge_y0[i]),
+                         Eigen::Vector2d(msg.edge_x1[i], msg.edge_y1[i]));
+  }
+  const Eigen::Vector4d axle(msg.rear_axle[0], msg.rear_axle[1], msg.rear_axle[2], msg.rear_axle[3]);
+  if (axle.allFinite()) m.rear_axle = Segment({axle(0), axle(1)}, {axle(2), axle(3)});
+  const std::size_t np = std::min(msg.point_x.size(), msg.point_y.size());
+  m.points.reserve(np);
+  for (std::size_t i = 0; i < np; ++i) m.points.emplace_back(msg.point_x[i], msg.point_y[i]);
+  m.point_edge.assign(msg.point_edge.begin(), msg.point_edge.begin() +
+                                                  static_cast<std::ptrdiff_t>(
+                                                      std::min(np, msg.point_edge.size())));
+  for (const auto& h : msg.hypotheses) {
+    SceneHypothesis sh;
+    sh.index = h.index;
+    sh.model = h.model == vtrack::track_t::MODEL_VASM ? MotionModel::kVasm : MotionModel::kIsm;
+    sh.selected = h.selected;
+    sh.box = MakeBox(h.x, h.y, h.theta, length, width);
+    sh.rear_axle_offset = h.rear_axle_offset;
+    sh.score = h.score;
+    m.hypotheses.push_back(sh);
+  }
+  return m;
+}
+
+SceneTruth TruthFromMsg(const vtrack::object_t& msg) {
+  SceneTruth g;
+  g.id = msg.id;
+  g.object_class = msg.object_class;
+  g.box = MakeBox(msg.x, msg.y, msg.yaw, msg.length, msg.width);
+  g.rear_axle_offset = msg.rear_axle_offset;
+  g.speed = msg.speed;
+  g.moving = msg.moving;
+  g.in_labelled_region = msg.in_labelled_region;
+  return g;
+}
+
+}  // namespace vtrack::viewer

@@ -471,8 +471,10 @@ class Builder {
       o.shape = Shape::kBox;
       o.center = 0.5 * (a + b);
       o.yaw = std::atan2(b.y() - a.y(), b.x() - a.x());
-      o.length = (b - a).norm();
       o.width = r_.Num(w, p, "thickness", d.width, 0.05, 10.0);
+      // from/to are the centreline's end points; the wall reaches half its thickness beyond them
+      // so that two walls sharing an end point meet in a closed corner.
+      o.length = (b - a).norm() + o.width;
       o.height = r_.Num(w, p, "height", d.height, 0.1, 100.0);
       o.reflectance = r_.Num(w, p, "reflectance", d.reflectance, 0.0, 1.0);
       o.rotation_axis_offset = std::nan("");
@@ -757,7 +759,8 @@ class Builder {
   std::int64_t next_id_ = 1;
 };
 
-Scenario LoadScenarioChecked(const std::string& path, std::optional<double> duration_override);
+Scenario LoadScenarioChecked(const std::string& path, std::optional<double> duration_override,
+                             int depth);
 
 YAML::Node Merge(const YAML::Node& base, const YAML::Node& over) {
   if (!base.IsMap() || !over.IsMap()) return over;
@@ -804,7 +807,7 @@ YAML::Node LoadTree(const std::string& path, int depth, std::vector<Doc>* docs) 
     }
   }
   // The base must be a valid scenario by itself: its errors are reported against its own file.
-  LoadScenario(base_path);
+  LoadScenarioChecked(base_path, std::nullopt, depth + 1);
   const YAML::Node base = LoadTree(base_path, depth + 1, docs);
   YAML::Node over(YAML::NodeType::Map);
   for (const auto& kv : root) {
@@ -829,7 +832,7 @@ LadarParams Scenario::Sensor(const std::string& which) const {
 
 Scenario LoadScenario(const std::string& path, std::optional<double> duration_override) {
   try {
-    return LoadScenarioChecked(path, duration_override);
+    return LoadScenarioChecked(path, duration_override, 0);
   } catch (const YAML::Exception& e) {
     // Every expected problem is reported with its key above; this catches what yaml-cpp alone
     // notices (e.g. subscripting a scalar), so that a bad file never escapes as a crash.
@@ -839,9 +842,10 @@ Scenario LoadScenario(const std::string& path, std::optional<double> duration_ov
 }
 
 namespace {
-Scenario LoadScenarioChecked(const std::string& path, std::optional<double> duration_override) {
+Scenario LoadScenarioChecked(const std::string& path, std::optional<double> duration_override,
+                             int depth) {
   std::vector<Doc> docs;
-  const YAML::Node root = LoadTree(path, 0, &docs);
+  const YAML::Node root = LoadTree(path, depth, &docs);
   Reader r(&docs);
   r.CheckKeys(root, "", {"name", "description", "extends", "duration", "start_utime", "seed",
                          "truth", "sensor", "sensors", "ego", "vehicles", "traffic", "parked",

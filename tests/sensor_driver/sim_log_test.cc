@@ -62,8 +62,10 @@ TEST(SimLogTest, SameSeedGivesAByteIdenticalLog) {
   const std::string dir = ScratchDir("sim_log_seed");
   // Figure 6 draws everywhere: range noise, dropouts, spurious returns, bush depths, pose noise.
   auto run = [&](const std::string& out, const std::string& seed, const std::string& sensor) {
-    return SimLog({"--scenario", "paper_fig6_noisy_follow", "--duration", "3", "--seed", seed,
-                   "--sensor", sensor, "--out", dir + "/" + out, "-q"},
+    // 3 s of the single-plane sensor (75 scans), 0.5 s of the 64-layer one (4 scans, 11 MB).
+    return SimLog({"--scenario", "paper_fig6_noisy_follow", "--duration",
+                   sensor == "velodyne64" ? "0.5" : "3", "--seed", seed, "--sensor", sensor,
+                   "--out", dir + "/" + out, "-q"},
                   dir + "/" + out + ".txt");
   };
   for (const std::string sensor : {"single_plane", "velodyne64"}) {
@@ -75,7 +77,6 @@ TEST(SimLogTest, SameSeedGivesAByteIdenticalLog) {
     EXPECT_GT(a.size(), 100000u) << sensor;
     EXPECT_TRUE(a == b) << sensor << ": same seed, different bytes";
     EXPECT_FALSE(a == c) << sensor << ": another seed gave the same log";
-    EXPECT_EQ(a.size() > 0 && c.size() > 0, true);
   }
 }
 

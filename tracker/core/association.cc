@@ -38,6 +38,18 @@ double FaceDistance(const Eigen::Vector2d& q, Face f, double half_l, double half
   return kInf;
 }
 
+// OrientedBox::ToBoxFrame with cos/sin computed once per box, not per point.
+struct BoxFrame {
+  explicit BoxFrame(const OrientedBox& b)
+      : c(b.center), ax(std::cos(b.theta)), ay(std::sin(b.theta)) {}
+  Eigen::Vector2d To(double x, double y) const {
+    const double dx = x - c.x(), dy = y - c.y();
+    return {dx * ax + dy * ay, -dx * ay + dy * ax};
+  }
+  Eigen::Vector2d c;
+  double ax, ay;
+};
+
 bool Overlap(const Eigen::Vector2d& amin, const Eigen::Vector2d& amax, const Eigen::Vector2d& bmin,
              const Eigen::Vector2d& bmax) {
   return amin.x() <= bmax.x() && bmin.x() <= amax.x() && amin.y() <= bmax.y() &&
@@ -168,9 +180,10 @@ double Associator::PairCost(const PredictedObject& t, double margin, std::uint8_
   const double hl = 0.5 * t.box.length, hw = 0.5 * t.box.width;
   int inside = 0;
   double dist_sum = 0.0;
+  const BoxFrame frame(t.box);
   for (const std::int32_t i : part.points) {
     const auto iu = static_cast<std::size_t>(i);
-    const Eigen::Vector2d q = t.box.ToBoxFrame({pts.x[iu], pts.y[iu]});
+    const Eigen::Vector2d q = frame.To(pts.x[iu], pts.y[iu]);
     if (std::abs(q.x()) > hl + margin || std::abs(q.y()) > hw + margin) continue;
     ++inside;
     double d = kInf;
@@ -199,10 +212,13 @@ void Associator::BuildParts(const std::vector<PredictedObject>& tracks, const Wo
     for (std::size_t j = 0; j < tracks.size(); ++j) {
       if (!tracks[j].established || !Overlap(s.min, s.max, lo[j], hi[j])) continue;
       const double margin = GateMargin(tracks[j]);
+      const double hl = 0.5 * tracks[j].box.length + margin, hw = 0.5 * tracks[j].box.width + margin;
+      const BoxFrame frame(tracks[j].box);
       int inside = 0;
       for (std::int32_t k = s.begin; k < s.end; ++k) {
         const auto i = static_cast<std::size_t>(segments.point[static_cast<std::size_t>(k)]);
-        if (tracks[j].box.Contains({pts.x[i], pts.y[i]}, margin)) ++inside;
+        const Eigen::Vector2d q = frame.To(pts.x[i], pts.y[i]);
+        if (std::abs(q.x()) <= hl && std::abs(q.y()) <= hw) ++inside;
       }
       if (inside >= params_.split_min_points) claim.push_back(j);
     }
@@ -217,7 +233,7 @@ void Associator::BuildParts(const std::vector<PredictedObject>& tracks, const Wo
         for (std::size_t c = 0; c < claim.size(); ++c) {
           const OrientedBox& b = tracks[claim[c]].box;
           const auto iu = static_cast<std::size_t>(i);
-          const double d = SignedBoxDistance(b.ToBoxFrame({pts.x[iu], pts.y[iu]}),
+          const double d = SignedBoxDistance(BoxFrame(b).To(pts.x[iu], pts.y[iu]),
                                              0.5 * b.length, 0.5 * b.width);
           if (d < best_d) {
             best_d = d;

@@ -24,8 +24,8 @@ namespace vtrack {
 struct SegmentationParams {
   double jump_abs = 0.6;      // [m] scan line: minimum break distance between consecutive returns
   double jump_rel = 0.02;     // [-] scan line: break distance per metre of range
-  double cell_size = 0.35;    // [m] grid cell size for 3-D clouds
-  int connectivity = 8;       // [-] grid neighbourhood: 4 or 8
+  double cell_size = 0.3;     // [m] grid cell size for 3-D clouds
+  int connectivity = 4;       // [-] grid neighbourhood: 4 or 8 (8 joins cars parked 0.6 m apart)
   double grid_radius = 80.0;  // [m] half-size of the grid around the sensor (returns beyond: dropped)
   int min_points = 3;         // [-] smaller segments are dropped
   double max_extent = 25.0;   // [m] segments whose bounding-box diagonal is larger are dropped

@@ -1,0 +1,215 @@
+// vtrack-tracker: tracks vehicles from LADAR_SCAN + EGO_POSE and publishes TRACKS,
+// TRACKER_STATUS and (with --debug) TRACK_DEBUG.
+//
+//   live on the bus:   vtrack-tracker [--config F] [--mode mht|ism|vasm] [--lcm-url URL]
+//   over a log file:   vtrack-tracker --input run.lcm --output tracks.lcm [--mode ...] [--debug]
+//
+// Both ways go through the same TrackerNode and the same core calls; estimation uses message
+// time only. See tracker/README.md.
+#include <boost/program_options.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "lcmtypes/util/log_reader.h"
+#include "lcmtypes/util/process.h"
+#include "tracker/config.h"
+#include "tracker/tracker_node.h"
+
+namespace po = boost::program_options;
+using namespace vtrack;
+
+namespace {
+
+#ifndef VTRACK_DEFAULT_TRACKER_CONFIG
+#define VTRACK_DEFAULT_TRACKER_CONFIG ""
+#endif
+
+// LADAR_SCAN messages of a 64-beam sensor are ~2 MB: without a large socket buffer most are lost.
+std::string WithReceiveBuffer(std::string url) {
+  if (url.empty()) {
+    const char* env = std::getenv("LCM_DEFAULT_URL");
+    url = (env && *env) ? env : "udpm://239.255.76.67:7667?ttl=0";
+  }
+  if (url.rfind("udpm://", 0) != 0 || url.find("recv_buf_size=") != std::string::npos) return url;
+  return url + (url.find('?') == std::string::npos ? "?" : "&") + "recv_buf_size=4194304";
+}
+
+class LiveHandler {
+ public:
+  explicit LiveHandler(TrackerNode* node) : node_(node) {}
+  void OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    node_->Handle(channel, rbuf->data, rbuf->data_size);
+  }
+
+ private:
+  TrackerNode* node_;
+};
+
+int RunLive(const TrackerParams& params, const NodeOptions& options, const std::string& url_in,
+            double status_period_s) {
+  const std::string url = WithReceiveBuffer(url_in);
+  auto lcm = lcm_util::OpenLcm(url);
+  TrackerNode node(params, options,
+                   [&](std::int64_t, const std::string& ch, const void* data, std::size_t size) {
+                     lcm->publish(ch, data, static_cast<unsigned int>(size));
+                   });
+  LiveHandler handler(&node);
+  lcm->subscribe(options.scan_channel, &LiveHandler::OnMessage, &handler);
+  lcm->subscribe(options.pose_channel, &LiveHandler::OnMessage, &handler);
+  std::fprintf(stderr, "vtrack-tracker: live on %s, mode %s, %s + %s -> %s%s\n", url.c_str(),
+               ToString(params.manager.mode), options.scan_channel.c_str(),
+               options.pose_channel.c_str(), options.tracks_channel.c_str(),
+               options.debug ? (" + " + options.debug_channel).c_str() : "");
+  const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(status_period_s));
+  auto next_status = std::chrono::steady_clock::now() + period;
+  while (!lcm_util::StopRequested()) {
+    if (lcm->handleTimeout(100) < 0) {
+      std::fprintf(stderr, "vtrack-tracker: LCM handle failed on %s\n", url.c_str());
+      return 1;
+    }
+    if (std::chrono::steady_clock::now() >= next_status) {
+      node.PublishStatus(node.tracker().latest_utime());
+      next_status += period;
+    }
+  }
+  node.Flush();
+  node.PublishStatus(node.tracker().latest_utime());
+  std::fprintf(stderr, "vtrack-tracker: stopped after %lld scans (%lld processed, %lld dropped)\n",
+               static_cast<long long>(node.tracker().scans_received()),
+               static_cast<long long>(node.tracker().scans_processed()),
+               static_cast<long long>(node.tracker().scans_dropped()));
+  return 0;
+}
+
+int RunOffline(const TrackerParams& params, const NodeOptions& options, const std::string& input,
+               const std::string& output, double status_period_s, bool quiet) {
+  lcm_util::LogReader reader(input);
+  lcm_util::LogWriter writer(output);
+  TrackerNode node(params, options,
+                   [&](std::int64_t t, const std::string& ch, const void* data, std::size_t size) {
+                     writer.Write(t, ch, data, size);
+                   });
+  const auto start = std::chrono::steady_clock::now();
+  auto next_progress = start + std::chrono::seconds(2);
+  const auto status_period_us = static_cast<std::int64_t>(status_period_s * 1e6);
+  std::int64_t last_status = 0;
+  std::int64_t events = 0;
+  while (const lcm::LogEvent* ev = reader.Next()) {
+    if (lcm_util::StopRequested()) break;
+    ++events;
+    node.Handle(ev->channel, ev->data, static_cast<std::size_t>(ev->datalen));
+    const std::int64_t t = node.tracker().latest_utime();
+    if (t != 0 && (last_status == 0 || t >= last_status + status_period_us || t < last_status)) {
+      node.PublishStatus(t);
+      last_status = t;
+    }
+    if (!quiet && (events & 63) == 0 && std::chrono::steady_clock::now() >= next_progress) {
+      next_progress += std::chrono::seconds(2);
+      const double pct = reader.FileSize() > 0 ? 100.0 * reader.BytesRead() / reader.FileSize() : 0.0;
+      std::fprintf(stderr, "vtrack-tracker: %5.1f%% of %s, %lld scans processed\n", pct,
+                   input.c_str(), static_cast<long long>(node.tracker().scans_processed()));
+    }
+  }
+  node.Flush();
+  node.PublishStatus(node.tracker().latest_utime());
+  const double secs =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const tracker_status_t s = node.Status();
+  std::fprintf(stderr,
+               "vtrack-tracker: %s -> %s: %lld scans received, %lld processed, %lld dropped, "
+               "%lld poses, %lld decode errors, %lld resets, in %.1f s\n",
+               input.c_str(), output.c_str(), static_cast<long long>(s.scans_received),
+               static_cast<long long>(s.scans_processed), static_cast<long long>(s.scans_dropped),
+               static_cast<long long>(s.poses_received), static_cast<long long>(s.decode_errors),
+               static_cast<long long>(s.resets), secs);
+  for (int i = 0; i < s.num_reasons; ++i) {
+    std::fprintf(stderr, "vtrack-tracker:   rejected %-20s %lld\n", s.reject_reason[i].c_str(),
+                 static_cast<long long>(s.reject_count[i]));
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string config, mode, input, output, url;
+  NodeOptions options;
+  double status_period = 1.0;
+  po::options_description desc(
+      "vtrack-tracker: vehicle tracking from a scanning LADAR (LADAR_SCAN + EGO_POSE -> TRACKS).\n"
+      "Live on the LCM bus by default; over a log file with --input/--output.\nOptions");
+  desc.add_options()
+      ("help,h", "show this help")
+      ("config", po::value(&config)->default_value(VTRACK_DEFAULT_TRACKER_CONFIG),
+       "tracker parameters (YAML, see config/tracker.yaml); empty: built-in defaults")
+      ("mode", po::value(&mode), "mht (default) | ism | vasm: overrides the config's manager.mode")
+      ("input", po::value(&input), "LCM log to track offline, as fast as possible")
+      ("output", po::value(&output), "LCM log to write (with --input): TRACKS, TRACKER_STATUS, TRACK_DEBUG")
+      ("debug", po::bool_switch(&options.debug), "also publish TRACK_DEBUG (large)")
+      ("lcm-url", po::value(&url)->default_value(""),
+       "LCM URL for live mode ('' = $LCM_DEFAULT_URL or LCM's default); recv_buf_size=4194304 "
+       "is appended to udpm:// URLs that lack it")
+      ("scan-channel", po::value(&options.scan_channel)->default_value("LADAR_SCAN"), "input scans")
+      ("pose-channel", po::value(&options.pose_channel)->default_value("EGO_POSE"), "input ego poses")
+      ("tracks-channel", po::value(&options.tracks_channel)->default_value("TRACKS"), "output tracks")
+      ("debug-channel", po::value(&options.debug_channel)->default_value("TRACK_DEBUG"), "output debug")
+      ("status-channel", po::value(&options.status_channel)->default_value("TRACKER_STATUS"), "output status")
+      ("status-period", po::value(&status_period)->default_value(1.0),
+       "seconds between TRACKER_STATUS messages (wall time live, message time offline)")
+      ("quiet,q", "no progress output (offline)");
+  po::variables_map vm;
+  try {
+    po::store(po::parse_command_line(argc, argv, desc), vm);
+    po::notify(vm);
+  } catch (const po::error& e) {
+    std::cerr << "vtrack-tracker: " << e.what() << "\n(see --help)\n";
+    return 2;
+  }
+  if (vm.count("help")) {
+    std::cout << desc << "\n";
+    return 0;
+  }
+  if (input.empty() != output.empty()) {
+    std::cerr << "vtrack-tracker: --input and --output go together\n";
+    return 2;
+  }
+  if (!(status_period > 0.0 && status_period <= 3600.0)) {
+    std::cerr << "vtrack-tracker: --status-period " << status_period << " must be in (0, 3600]\n";
+    return 2;
+  }
+  try {
+    TrackerParams params;
+    if (!config.empty()) {
+      if (!std::filesystem::exists(config) && config == VTRACK_DEFAULT_TRACKER_CONFIG) {
+        std::cerr << "vtrack-tracker: default config " << config
+                  << " not found; using built-in defaults\n";
+      } else {
+        params = LoadTrackerParams(config);
+      }
+    }
+    if (vm.count("mode") && !ParseTrackerMode(mode, &params.manager.mode)) {
+      std::cerr << "vtrack-tracker: --mode '" << mode << "' must be mht, ism or vasm\n";
+      return 2;
+    }
+    std::string error;
+    if (!params.Validate(&error)) {
+      std::cerr << "vtrack-tracker: invalid parameters: " << error << "\n";
+      return 1;
+    }
+    lcm_util::InstallStopHandlers();
+    if (!input.empty()) {
+      return RunOffline(params, options, input, output, status_period, vm.count("quiet") > 0);
+    }
+    return RunLive(params, options, url, status_period);
+  } catch (const std::exception& e) {
+    std::cerr << "vtrack-tracker: " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,158 @@
+#include "tracker/tracker_node.h"
+
+#include <algorithm>
+#include <exception>
+
+#include "lcmtypes/util/decode.h"
+#include "tracker/lcm_convert.h"
+#include "vtrack/ladar_scan_t.hpp"
+#include "vtrack/pose_t.hpp"
+
+namespace vtrack {
+
+TrackerNode::TrackerNode(const TrackerParams& params, NodeOptions options, PublishFn publish)
+    : params_(params),
+      options_(std::move(options)),
+      publish_(std::move(publish)),
+      tracker_(params, options_.debug) {}
+
+void TrackerNode::Handle(const std::string& channel, const void* data, std::size_t size) {
+  // An LCM callback must never let an exception escape: anything unexpected is counted.
+  try {
+    if (channel == options_.scan_channel) {
+      ladar_scan_t msg;
+      std::string why;
+      const auto err = lcm_util::Decode(data, size, &msg, &why);
+      if (err != lcm_util::DecodeError::kNone) {
+        ++decode_errors_;
+        ++decode_reasons_[lcm_util::DecodeErrorName(err)];
+        log_.Warn(lcm_util::DecodeErrorName(err), "dropped a " + channel + " message of " +
+                                                      std::to_string(size) + " bytes: " +
+                                                      lcm_util::DecodeErrorName(err) +
+                                                      (why.empty() ? "" : " (" + why + ")"));
+        return;
+      }
+      arrival_.emplace_back(msg.utime, lcm_util::WallUtime());
+      if (arrival_.size() > 1000) arrival_.pop_front();
+      tracker_.AddScan(ScanFromLcm(std::move(msg)), &outs_);
+    } else if (channel == options_.pose_channel) {
+      pose_t msg;
+      std::string why;
+      const auto err = lcm_util::Decode(data, size, &msg, &why);
+      if (err != lcm_util::DecodeError::kNone) {
+        ++decode_errors_;
+        ++decode_reasons_[lcm_util::DecodeErrorName(err)];
+        log_.Warn(lcm_util::DecodeErrorName(err),
+                  "dropped a " + channel + " message: " + lcm_util::DecodeErrorName(err) +
+                      (why.empty() ? "" : " (" + why + ")"));
+        return;
+      }
+      tracker_.AddPose(PoseFromLcm(msg), &outs_);
+    } else {
+      return;
+    }
+  } catch (const std::exception& e) {
+    ++decode_reasons_["internal_error"];
+    log_.Warn("internal_error", std::string("message on ") + channel + " dropped: " + e.what());
+    outs_.clear();
+  }
+  Emit(&outs_);
+  Warn();
+}
+
+void TrackerNode::Flush() {
+  try {
+    tracker_.Flush(&outs_);
+  } catch (const std::exception& e) {
+    ++decode_reasons_["internal_error"];
+    log_.Warn("internal_error", std::string("flush failed: ") + e.what());
+    outs_.clear();
+  }
+  Emit(&outs_);
+  Warn();
+}
+
+void TrackerNode::Warn() {
+  for (const auto& e : tracker_.TakeEvents()) {
+    if (e.reason == "reset") {
+      std::fprintf(stderr, "vtrack-tracker: %s\n", e.message.c_str());  // always said
+    } else {
+      log_.Warn(e.reason, e.message);
+    }
+  }
+}
+
+void TrackerNode::Emit(std::vector<ScanOutput>* outs) {
+  const std::string mode = ToString(params_.manager.mode);
+  for (const ScanOutput& o : *outs) {
+    std::int64_t latency_us = 0;
+    const auto it = std::find_if(arrival_.begin(), arrival_.end(),
+                                 [&](const auto& a) { return a.first == o.utime; });
+    if (it != arrival_.end()) {
+      latency_us = lcm_util::WallUtime() - it->second;
+      arrival_.erase(arrival_.begin(), it + 1);
+    }
+    last_latency_ms_ = latency_us * 1e-3;
+    latencies_ms_.push_back(last_latency_ms_);
+    if (latencies_ms_.size() > 100) latencies_ms_.pop_front();
+    const track_list_t msg = TrackListToLcm(o, mode, latency_us);
+    buffer_.resize(static_cast<std::size_t>(msg.getEncodedSize()));
+    msg.encode(buffer_.data(), 0, static_cast<int>(buffer_.size()));
+    publish_(o.utime, options_.tracks_channel, buffer_.data(), buffer_.size());
+    ++tracks_published_;
+    if (options_.debug) {
+      const track_debug_t dbg = DebugToLcm(o);
+      buffer_.resize(static_cast<std::size_t>(dbg.getEncodedSize()));
+      dbg.encode(buffer_.data(), 0, static_cast<int>(buffer_.size()));
+      publish_(o.utime, options_.debug_channel, buffer_.data(), buffer_.size());
+    }
+    last_tentative_ = last_confirmed_ = last_coasting_ = 0;
+    for (const auto& t : o.tracks) {
+      if (t.status == TrackStatus::kTentative) ++last_tentative_;
+      else if (t.status == TrackStatus::kConfirmed) ++last_confirmed_;
+      else ++last_coasting_;
+    }
+  }
+  outs->clear();
+}
+
+tracker_status_t TrackerNode::Status() const {
+  tracker_status_t s;
+  s.utime = tracker_.latest_utime();
+  s.wall_utime = lcm_util::WallUtime();
+  s.mode = ToString(params_.manager.mode);
+  s.scans_received = tracker_.scans_received() ;
+  s.scans_processed = tracker_.scans_processed();
+  s.scans_dropped = tracker_.scans_dropped();
+  s.poses_received = tracker_.poses_received();
+  s.decode_errors = decode_errors_;
+  s.resets = tracker_.resets();
+  std::map<std::string, std::int64_t> reasons = tracker_.rejects();
+  for (const auto& [k, v] : decode_reasons_) reasons[k] += v;
+  s.num_reasons = static_cast<int32_t>(reasons.size());
+  for (const auto& [k, v] : reasons) {
+    s.reject_reason.push_back(k);
+    s.reject_count.push_back(v);
+  }
+  s.last_latency_ms = last_latency_ms_;
+  std::vector<double> l(latencies_ms_.begin(), latencies_ms_.end());
+  if (!l.empty()) {
+    std::nth_element(l.begin(), l.begin() + static_cast<std::ptrdiff_t>(l.size() / 2), l.end());
+    s.median_latency_ms = l[l.size() / 2];
+  } else {
+    s.median_latency_ms = 0.0;
+  }
+  s.tracks_tentative = static_cast<int32_t>(last_tentative_);
+  s.tracks_confirmed = static_cast<int32_t>(last_confirmed_);
+  s.tracks_coasting = static_cast<int32_t>(last_coasting_);
+  return s;
+}
+
+void TrackerNode::PublishStatus(std::int64_t event_utime) {
+  const tracker_status_t s = Status();
+  buffer_.resize(static_cast<std::size_t>(s.getEncodedSize()));
+  s.encode(buffer_.data(), 0, static_cast<int>(buffer_.size()));
+  publish_(event_utime, options_.status_channel, buffer_.data(), buffer_.size());
+}
+
+}  // namespace vtrack

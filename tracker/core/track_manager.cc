@@ -144,6 +144,7 @@ TrackManager::TrackManager(const TrackManagerParams& params, const Ekf& ekf,
   if (!params_.Validate(&error)) throw std::invalid_argument(error);
   if (!shape_params_.Validate(&error)) throw std::invalid_argument(error);
   mover_d2_ = ChiSquareQuantile(params_.mover_confidence, 2);
+  mover_d1_ = ChiSquareQuantile(params_.mover_confidence, 1);
 }
 
 Hypothesis TrackManager::PredictedSelected(const Track& t, std::int64_t utime) const {
@@ -282,6 +283,10 @@ void TrackManager::Update(std::size_t index, const PointSet& points,
       t.hyps.push_back(std::move(fresh));
       t.selected = 0;
       t.small_object = false;
+      // Centroids of a few returns slide along a surface as the view changes: motion judged
+      // from them is not evidence; the test starts over on the rectangle.
+      t.mover = false;
+      t.motion_evidence = 0;
     }
   }
 
@@ -503,14 +508,25 @@ void TrackManager::TestMotion(Track* t) {
   const Eigen::Matrix2d C = 0.5 * (c.velocity_cov + c.velocity_cov.transpose());
   Eigen::LLT<Eigen::Matrix2d> llt(C);
   bool evidence = false;
-  if (llt.info() == Eigen::Success && c.velocity.allFinite()) {
+  if (sel.has_fit && sel.fit.kind == FitKind::kEdge && c.velocity.allFinite()) {
+    // A single edge fixes the position across the face only: along it the centre follows the
+    // extent of the returns, which slides as the view changes. Only the velocity across the
+    // face is evidence of motion (1-dof test).
+    const Eigen::Vector2d n(-std::sin(sel.fit.phi), std::cos(sel.fit.phi));
+    const double vn = n.dot(c.velocity), var = n.dot(C * n);
+    evidence = var > 0.0 && vn * vn / var > mover_d1_ && std::abs(vn) >= params_.mover_min_speed;
+  } else if (sel.has_fit && llt.info() == Eigen::Success && c.velocity.allFinite()) {
     const double d2 = c.velocity.dot(llt.solve(c.velocity));
     evidence = d2 > mover_d2_ && c.speed >= params_.mover_min_speed;
   }
+  // Without a fit (centroid of a few returns, or the fit failed) there is no evidence either way:
+  // a centroid slides with the view just the same.
+  if (!sel.has_fit) return;  // no evidence either way: the count is kept
   t->motion_evidence = evidence ? t->motion_evidence + 1 : 0;
   if (!t->mover && t->motion_evidence >= params_.mover_scans) {
     t->mover = true;
     AlignIsm(t);
+    AlignVasm(t);
   } else if (t->mover && evidence) {
     AlignIsm(t);
   }
@@ -542,6 +558,20 @@ void TrackManager::AlignIsm(Track* t) const {
       h.RefreshShape();
       std::swap(h.length_seen_full, h.width_seen_full);
     }
+  }
+}
+
+void TrackManager::AlignVasm(Track* t) const {
+  // Mode vasm: a VASM started from one fit may point backwards (theta + pi, v < 0, L > 0
+  // describe the same motion). At the mover declaration it is turned to point along its motion,
+  // (theta, v, L) -> (theta + pi, -v, -L), P -> D P D^T with D = diag(1, 1, -1, -1, 1, 1).
+  for (auto& h : t->hyps) {
+    if (h.filter.kind != ModelKind::kVasm || h.filter.x(3) >= 0.0) continue;
+    Matrix6d D = Matrix6d::Identity();
+    D(2, 2) = D(3, 3) = -1.0;
+    h.filter.x = D * h.filter.x;
+    h.filter.x(4) = WrapToPi(h.filter.x(4) + kPi);
+    h.filter.P = D * h.filter.P * D.transpose();
   }
 }
 

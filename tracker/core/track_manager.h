@@ -16,7 +16,10 @@
 // Mover test. On every scan that updates the object, the centre velocity v (2-vector) and its
 // covariance C of the reported hypothesis give d^2 = v^T C^-1 v. The scan is evidence of motion
 // if d^2 exceeds the chi-square (2 dof) quantile of mover_confidence and |v| >= mover_min_speed.
-// mover_scans consecutive such scans declare a mover; a mover stays a mover.
+// When the fit was a single edge, only the velocity across the edge counts (1 dof): along it the
+// centre follows the extent of the returns, which slides as the ego passes a parked car. Centroid
+// measurements (small objects) give no evidence. mover_scans consecutive such scans declare a
+// mover; a mover stays a mover (a rectangle that grows out of a small object starts over).
 //
 // Orientation at the mover declaration. A fit gives theta modulo 90 deg (corner) or 180 deg
 // (edge); the velocity heading psi tells the length axis of a moving vehicle. With delta the
@@ -249,6 +252,7 @@ class TrackManager {
   void TestMotion(Track* t);
   void SpawnVasms(Track* t) const;
   void AlignToShape(Track* t) const;
+  void AlignVasm(Track* t) const;
   void AlignIsm(Track* t) const;
   bool SmallObject(const PointSet& points) const;
 
@@ -256,7 +260,7 @@ class TrackManager {
   const Ekf& ekf_;
   SegmentFitter fitter_;
   ShapeParams shape_params_;
-  double mover_d2_ = 0.0;
+  double mover_d2_ = 0.0, mover_d1_ = 0.0;
   std::vector<Track> tracks_;
   std::int64_t next_id_ = 1;
 };

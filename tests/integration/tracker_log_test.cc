@@ -1,0 +1,284 @@
+// vtrack-tracker over log files (the real executables): tracking quality on simulated scenarios
+// against their ground truth, identical output when a log is processed twice, the hypothesis
+// counts of the multi-hypothesis manager, and every bad input of DESIGN section 9 counted in
+// TRACKER_STATUS.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "lcmtypes/util/decode.h"
+#include "lcmtypes/util/log_reader.h"
+#include "tests/integration/tracker_eval.h"
+#include "tests/support/subprocess.h"
+#include "tests/support/test_env.h"
+#include "vtrack/ladar_scan_t.hpp"
+#include "vtrack/pose_t.hpp"
+#include "vtrack/track_list_t.hpp"
+#include "vtrack/tracker_status_t.hpp"
+
+namespace vtrack::testing {
+namespace {
+
+std::string Bin(const std::string& name) { return BinDir() + "/" + name; }
+
+// Writes a scenario's log (vtrack-sim-log) into dir, once per test binary run.
+std::string SimLog(const std::string& dir, const std::string& scenario, double duration_s = 0) {
+  const std::string out = dir + "/" + scenario + ".lcm";
+  std::vector<std::string> argv = {Bin("vtrack-sim-log"), "--scenario", scenario, "--out", out, "-q"};
+  if (duration_s > 0) {
+    argv.push_back("--duration");
+    argv.push_back(std::to_string(duration_s));
+  }
+  const int rc = RunCommand(argv, dir + "/" + scenario + "-sim.txt");
+  if (rc != 0 || !std::filesystem::exists(out)) {
+    ADD_FAILURE() << "vtrack-sim-log failed (" << rc << "): " << ReadFile(dir + "/" + scenario + "-sim.txt");
+  }
+  return out;
+}
+
+int Track(const std::string& in, const std::string& out, const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> argv = {Bin("vtrack-tracker"), "--input", in, "--output", out, "-q"};
+  argv.insert(argv.end(), extra.begin(), extra.end());
+  return RunCommand(argv, out + ".txt");
+}
+
+std::vector<track_list_t> ReadTracks(const std::string& path) {
+  std::vector<track_list_t> v;
+  lcm_util::LogReader r(path);
+  while (const lcm::LogEvent* ev = r.Next()) {
+    if (ev->channel != "TRACKS") continue;
+    track_list_t m;
+    EXPECT_EQ(lcm_util::Decode(ev->data, static_cast<std::size_t>(ev->datalen), &m),
+              lcm_util::DecodeError::kNone);
+    m.latency_us = 0;  // wall-clock latency: the only field allowed to differ between runs
+    v.push_back(std::move(m));
+  }
+  return v;
+}
+
+tracker_status_t LastStatus(const std::string& path) {
+  tracker_status_t last;
+  lcm_util::LogReader r(path);
+  while (const lcm::LogEvent* ev = r.Next()) {
+    if (ev->channel != "TRACKER_STATUS") continue;
+    EXPECT_EQ(lcm_util::Decode(ev->data, static_cast<std::size_t>(ev->datalen), &last),
+              lcm_util::DecodeError::kNone);
+  }
+  return last;
+}
+
+class TrackerLogTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { dir_ = new std::string(ScratchDir("tracker_log")); }
+  static std::string* dir_;
+};
+std::string* TrackerLogTest::dir_ = nullptr;
+
+TEST_F(TrackerLogTest, Fig4TurnIsTrackedWithoutIdentitySwitchInEveryMode) {
+  const std::string sim = SimLog(*dir_, "paper_fig4_turn");
+  for (const std::string mode : {"mht", "ism", "vasm"}) {
+    SCOPED_TRACE(mode);
+    const std::string out = *dir_ + "/fig4-" + mode + ".lcm";
+    ASSERT_EQ(Track(sim, out, {"--mode", mode}), 0) << ReadFile(out + ".txt");
+    const EvalResult r = EvaluateTracks(sim, out);
+    std::printf("paper_fig4_turn %s: %s\n", mode.c_str(), Summary(r).c_str());
+    EXPECT_GT(r.due, 300);
+    if (mode == "mht") {
+      // The tracker as shipped; ism and vasm are the baselines of the comparison (README).
+      EXPECT_EQ(r.matched, r.due) << (r.misses.empty() ? "" : r.misses.front());
+      EXPECT_EQ(r.id_switches, 0);
+      EXPECT_LT(r.position_rmse, 0.35);
+      EXPECT_EQ(r.max_hyps_not_moving, 1);
+      EXPECT_LE(r.max_hyps_moving, 4);
+      EXPECT_GE(r.max_hyps_moving, 2);  // the turning car gained VASMs
+    } else {
+      EXPECT_GE(r.matched, r.due * 9 / 10);
+      EXPECT_EQ(r.max_hyps_moving, r.max_hyps_moving > 0 ? 1 : 0);
+      EXPECT_EQ(r.max_hyps_not_moving, 1);
+    }
+  }
+}
+
+TEST_F(TrackerLogTest, ProcessingALogTwiceGivesIdenticalTracks) {
+  const std::string sim = SimLog(*dir_, "paper_fig4_turn");
+  const std::string a = *dir_ + "/twice-a.lcm", b = *dir_ + "/twice-b.lcm";
+  ASSERT_EQ(Track(sim, a, {"--debug"}), 0);
+  ASSERT_EQ(Track(sim, b, {"--debug"}), 0);
+  const auto ta = ReadTracks(a), tb = ReadTracks(b);
+  ASSERT_GT(ta.size(), 300u);
+  ASSERT_EQ(ta.size(), tb.size());
+  std::vector<std::uint8_t> ea, eb;
+  for (std::size_t i = 0; i < ta.size(); ++i) {
+    ea.resize(static_cast<std::size_t>(ta[i].getEncodedSize()));
+    eb.resize(static_cast<std::size_t>(tb[i].getEncodedSize()));
+    ta[i].encode(ea.data(), 0, static_cast<int>(ea.size()));
+    tb[i].encode(eb.data(), 0, static_cast<int>(eb.size()));
+    ASSERT_EQ(ea, eb) << "TRACKS message " << i << " differs";
+  }
+}
+
+TEST_F(TrackerLogTest, UrbanIntersectionStationaryObjectsHoldOneHypothesisMoversAtMostFour) {
+  // The first 12 s of the busy intersection (64-layer sensor): parked cars, movers, clutter.
+  const std::string sim = SimLog(*dir_, "urban_intersection", 12.0);
+  const std::string out = *dir_ + "/urban-mht.lcm";
+  ASSERT_EQ(Track(sim, out), 0) << ReadFile(out + ".txt");
+  const EvalResult r = EvaluateTracks(sim, out);
+  std::printf("urban_intersection (12 s) mht: %s\n", Summary(r).c_str());
+  for (const auto& m : r.stationary_multi) std::printf("  %s\n", m.c_str());
+  EXPECT_EQ(r.max_hyps_not_moving, 1);             // every track not judged a mover
+  EXPECT_LE(r.max_hyps_moving, 4);
+  EXPECT_GE(r.max_hyps_moving, 2);
+  // Tracks on parked vehicles: those the mover test wrongly judged moving (a partly seen side
+  // whose fitted extent slides as the ego passes; tracker/README.md, open issues) carry VASMs.
+  // Reported, and bounded by the four of a mover.
+  EXPECT_LE(r.max_hyps_stationary_truth, 4);
+  std::printf("parked vehicles on multi-hypothesis tracks: %zu samples listed\n",
+              r.stationary_multi.size());
+  std::filesystem::remove(sim);                    // 300 MB
+}
+
+// A log with every kind of bad input, each of which must be counted by its reason.
+TEST_F(TrackerLogTest, EveryBadInputIsCountedInTrackerStatus) {
+  const std::string sim = SimLog(*dir_, "paper_fig4_turn", 3.0);
+  const std::string bad = *dir_ + "/bad-input.lcm";
+  {
+    lcm_util::LogReader in(sim);
+    lcm_util::LogWriter out(bad);
+    int scans = 0, poses = 0;
+    ladar_scan_t previous;
+    bool have_previous = false;
+    std::vector<std::uint8_t> buf;
+    auto write = [&](std::int64_t t, const std::string& ch, const auto& msg) {
+      buf.resize(static_cast<std::size_t>(msg.getEncodedSize()));
+      msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
+      out.Write(t, ch, buf.data(), buf.size());
+    };
+    while (const lcm::LogEvent* ev = in.Next()) {
+      const auto size = static_cast<std::size_t>(ev->datalen);
+      if (ev->channel == "EGO_POSE") {
+        ++poses;
+        out.Write(ev->timestamp, ev->channel, ev->data, size);
+        pose_t p;
+        ASSERT_EQ(lcm_util::Decode(ev->data, size, &p), lcm_util::DecodeError::kNone);
+        if (poses == 20) write(ev->timestamp, "EGO_POSE", p);       // repeated pose
+        if (poses == 30) {                                           // not a rotation
+          p.utime += 1;
+          p.orientation[0] = 3.0;
+          write(ev->timestamp, "EGO_POSE", p);
+        }
+        continue;
+      }
+      if (ev->channel != "LADAR_SCAN") continue;
+      ++scans;
+      ladar_scan_t s;
+      ASSERT_EQ(lcm_util::Decode(ev->data, size, &s), lcm_util::DecodeError::kNone);
+      if (scans == 5) {  // NaN and Inf returns
+        s.x[0] = std::numeric_limits<float>::quiet_NaN();
+        s.y[1] = std::numeric_limits<float>::infinity();
+      }
+      if (scans == 8) {  // empty scan
+        s.npoints = 0;
+        s.x.clear(); s.y.clear(); s.z.clear(); s.intensity.clear(); s.dt_us.clear(); s.ring.clear();
+      }
+      if (scans == 11) {  // huge scan (the test config allows 2000 returns)
+        const int n = 3000;
+        s.npoints = n;
+        s.x.assign(n, 5.0f); s.y.assign(n, 1.0f); s.z.assign(n, 0.0f);
+        s.intensity.assign(n, 0.0f); s.dt_us.assign(n, 0); s.ring.assign(n, 0);
+      }
+      write(ev->timestamp, "LADAR_SCAN", s);
+      if (scans == 14 && have_previous) write(ev->timestamp, "LADAR_SCAN", previous);  // older
+      if (scans == 17) write(ev->timestamp, "LADAR_SCAN", s);                          // repeated
+      if (scans == 20) {
+        out.Write(ev->timestamp, "LADAR_SCAN", ev->data, 5);          // shorter than a fingerprint
+        out.Write(ev->timestamp, "LADAR_SCAN", ev->data, size / 2);   // truncated
+        pose_t p;
+        write(ev->timestamp, "LADAR_SCAN", p);                        // another type
+        const auto* bytes = static_cast<const std::uint8_t*>(ev->data);
+        std::vector<std::uint8_t> inflated(bytes, bytes + size);
+        // npoints sits after utime, seq, sensor_id, pose, sweep, range, rings: set it huge.
+        const std::size_t off = 8 + 8 + 8 + 4 + s.sensor_id.size() + 1 + 24 + 32 + 4 + 4 + 2;
+        inflated[off] = 0x7f;
+        out.Write(ev->timestamp, "LADAR_SCAN", inflated.data(), inflated.size());
+      }
+      previous = s;
+      have_previous = true;
+    }
+  }
+  const std::string config = *dir_ + "/small.yaml";
+  std::ofstream(config) << "preprocess:\n  max_points: 2000\n";
+  const std::string out = *dir_ + "/bad-out.lcm";
+  ASSERT_EQ(Track(bad, out, {"--config", config}), 0) << ReadFile(out + ".txt");
+  const tracker_status_t st = LastStatus(out);
+  std::map<std::string, std::int64_t> reasons;
+  for (int i = 0; i < st.num_reasons; ++i) reasons[st.reject_reason[i]] = st.reject_count[i];
+  for (const auto& [k, v] : reasons) std::printf("  %s: %lld\n", k.c_str(), static_cast<long long>(v));
+  EXPECT_EQ(reasons["nan_point"], 2);
+  EXPECT_EQ(reasons["empty_scan"], 1);
+  EXPECT_EQ(reasons["huge_scan"], 1);
+  EXPECT_EQ(reasons["scan_out_of_order"], 1);
+  EXPECT_EQ(reasons["scan_repeated"], 1);
+  EXPECT_EQ(reasons["pose_repeated"], 1);
+  EXPECT_EQ(reasons["invalid_pose"], 1);
+  EXPECT_EQ(reasons["decode_too_short"], 1);
+  EXPECT_EQ(reasons["decode_wrong_type"], 1);
+  EXPECT_GE(reasons["decode_malformed"] + reasons["decode_bad_length"], 2);
+  EXPECT_EQ(st.decode_errors, 4);
+  EXPECT_EQ(st.scans_received, st.scans_processed + st.scans_dropped);
+  EXPECT_EQ(st.scans_dropped, 4);  // empty, huge, older, repeated
+  // And the tracking went on: the turning car is tracked in the output.
+  const auto tracks = ReadTracks(out);
+  ASSERT_FALSE(tracks.empty());
+  EXPECT_GT(tracks.back().num_tracks, 0);
+}
+
+TEST_F(TrackerLogTest, LoopedLogResetsTheTrackerWithoutReusingIds) {
+  const std::string sim = SimLog(*dir_, "paper_fig4_turn", 3.0);
+  const std::string looped = *dir_ + "/looped.lcm";
+  {
+    lcm_util::LogWriter out(looped);
+    for (int pass = 0; pass < 2; ++pass) {
+      lcm_util::LogReader in(sim);
+      while (const lcm::LogEvent* ev = in.Next()) {
+        out.Write(ev->timestamp, ev->channel, ev->data, static_cast<std::size_t>(ev->datalen));
+      }
+    }
+  }
+  const std::string out = *dir_ + "/looped-out.lcm";
+  ASSERT_EQ(Track(looped, out), 0);
+  EXPECT_NE(ReadFile(out + ".txt").find("reset"), std::string::npos) << "reset said on stderr";
+  EXPECT_EQ(LastStatus(out).resets, 1);
+  const auto tracks = ReadTracks(out);
+  std::int64_t max_id_before = 0, min_id_after = std::numeric_limits<std::int64_t>::max();
+  bool after = false;
+  std::int64_t last_utime = 0;
+  for (const auto& m : tracks) {
+    if (m.utime < last_utime) after = true;
+    last_utime = m.utime;
+    for (const auto& t : m.tracks) {
+      if (after) min_id_after = std::min(min_id_after, t.id);
+      else max_id_before = std::max(max_id_before, t.id);
+    }
+  }
+  ASSERT_TRUE(after);
+  EXPECT_GT(min_id_after, max_id_before);
+}
+
+TEST(TrackerCliTest, HelpAndBadOptions) {
+  EXPECT_EQ(RunCommand({Bin("vtrack-tracker"), "--help"}), 0);
+  EXPECT_EQ(RunCommand({Bin("vtrack-tracker"), "--no-such-option"}), 2);
+  EXPECT_EQ(RunCommand({Bin("vtrack-tracker"), "--mode", "kalman", "--input", "/dev/null",
+                        "--output", "/dev/null"}), 2);
+  EXPECT_EQ(RunCommand({Bin("vtrack-tracker"), "--input", "/nonexistent.lcm", "--output",
+                        "/tmp/vtrack-never.lcm"}), 1);
+}
+
+}  // namespace
+}  // namespace vtrack::testing

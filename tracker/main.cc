@@ -71,6 +71,7 @@ int RunLive(const TrackerParams& params, const NodeOptions& options, const std::
   auto next_status = std::chrono::steady_clock::now() + period;
   while (!lcm_util::StopRequested()) {
     if (lcm->handleTimeout(100) < 0) {
+      if (lcm_util::StopRequested()) break;  // the stop signal interrupted the wait
       std::fprintf(stderr, "vtrack-tracker: LCM handle failed on %s\n", url.c_str());
       return 1;
     }

@@ -1,0 +1,207 @@
+// vtrack-tracker live on a real LCM bus (udpm://, inside a private network namespace: ctest runs
+// this through scripts/vtrack-netns): the simulator's driver and ego-pose processes publish a
+// scenario in real time, lcm-logger records everything, and the recording is scored against
+// the ground truth on it. The same scenario written by vtrack-sim-log (byte for byte the same
+// messages) is tracked offline, and the live TRACKS must match the offline ones; lcm-logplayer
+// feeding the same log live must give the same too.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "lcmtypes/util/decode.h"
+#include "lcmtypes/util/log_reader.h"
+#include "lcmtypes/util/process.h"
+#include "tests/integration/tracker_eval.h"
+#include "tests/support/subprocess.h"
+#include "tests/support/test_env.h"
+#include "vtrack/track_list_t.hpp"
+#include "vtrack/tracker_status_t.hpp"
+
+namespace vtrack::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+const char* kLoggerUrl = "--lcm-url=udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304";
+
+std::string Bin(const std::string& name) { return BinDir() + "/" + name; }
+
+std::map<std::int64_t, track_list_t> TracksByUtime(const std::string& path) {
+  std::map<std::int64_t, track_list_t> m;
+  lcm_util::LogReader r(path);
+  while (const lcm::LogEvent* ev = r.Next()) {
+    if (ev->channel != "TRACKS") continue;
+    track_list_t t;
+    if (lcm_util::Decode(ev->data, static_cast<std::size_t>(ev->datalen), &t) ==
+        lcm_util::DecodeError::kNone) {
+      m[t.utime] = std::move(t);
+    }
+  }
+  return m;
+}
+
+// Compares two tracker outputs scan by scan: same track ids, states within tolerance [m, rad].
+// Returns the number of scans compared; failures are reported.
+int CompareTracks(const std::map<std::int64_t, track_list_t>& a,
+                  const std::map<std::int64_t, track_list_t>& b, double tol) {
+  int compared = 0, mismatched = 0;
+  double worst = 0.0;
+  for (const auto& [utime, la] : a) {
+    const auto it = b.find(utime);
+    if (it == b.end()) continue;
+    ++compared;
+    const track_list_t& lb = it->second;
+    std::map<std::int64_t, const track_t*> ib;
+    for (const auto& t : lb.tracks) ib[t.id] = &t;
+    bool same = la.tracks.size() == lb.tracks.size();
+    for (const auto& t : la.tracks) {
+      const auto jt = ib.find(t.id);
+      if (jt == ib.end()) {
+        same = false;
+        continue;
+      }
+      const double d = std::max({std::abs(t.x - jt->second->x), std::abs(t.y - jt->second->y),
+                                 std::abs(t.theta - jt->second->theta)});
+      worst = std::max(worst, d);
+      if (d > tol) same = false;
+    }
+    if (!same && ++mismatched <= 3) {
+      ADD_FAILURE() << "scan at " << utime << ": " << la.tracks.size() << " vs "
+                    << lb.tracks.size() << " tracks, ids or states differ";
+    }
+  }
+  std::printf("compared %d scans: %d differ, largest state difference %.3g\n", compared,
+              mismatched, worst);
+  return compared;
+}
+
+struct LiveRun {
+  std::string dir, live_log, sim_log, offline;
+  std::int64_t start_utime = 0;
+};
+
+// Logger + tracker + driver + ego pose, one lap of the scenario; then the same lap offline.
+LiveRun RunLive(const std::string& scenario, double duration_s) {
+  LiveRun run;
+  run.dir = ScratchDir("tracker_live_" + scenario);
+  run.live_log = run.dir + "/live.lcm";
+  run.start_utime = lcm_util::WallUtime() + 3'000'000;  // processes up and subscribed by then
+  const std::string u = std::to_string(run.start_utime);
+  const std::string d = std::to_string(duration_s);
+  {
+    Subprocess logger({"lcm-logger", "-q", "-f", kLoggerUrl, run.live_log}, run.dir + "/logger.txt");
+    Subprocess tracker({Bin("vtrack-tracker")}, run.dir + "/tracker.txt");
+    std::this_thread::sleep_for(500ms);
+    Subprocess ego({Bin("vtrack-ego-pose"), "--scenario", scenario, "--start-utime", u,
+                    "--duration", d, "--laps", "1", "-q"},
+                   run.dir + "/ego.txt");
+    Subprocess driver({Bin("vtrack-ladar-driver"), "--scenario", scenario, "--start-utime", u,
+                       "--duration", d, "--laps", "1", "-q"},
+                      run.dir + "/driver.txt");
+    const auto limit = std::chrono::milliseconds(static_cast<int>((duration_s + 30.0) * 1000));
+    const auto rd = driver.Wait(limit);
+    const auto re = ego.Wait(5s);
+    EXPECT_TRUE(rd && *rd == 0) << ReadFile(run.dir + "/driver.txt");
+    EXPECT_TRUE(re && *re == 0) << ReadFile(run.dir + "/ego.txt");
+    std::this_thread::sleep_for(1s);
+    EXPECT_EQ(tracker.Stop(), 0) << ReadFile(run.dir + "/tracker.txt");
+    std::this_thread::sleep_for(300ms);
+    logger.Stop();
+  }
+  // The same lap written straight to a log, and tracked offline.
+  run.sim_log = run.dir + "/sim.lcm";
+  EXPECT_EQ(RunCommand({Bin("vtrack-sim-log"), "--scenario", scenario, "--start-utime", u,
+                        "--duration", d, "--out", run.sim_log, "-q"},
+                       run.dir + "/sim.txt"),
+            0);
+  run.offline = run.dir + "/offline.lcm";
+  EXPECT_EQ(RunCommand({Bin("vtrack-tracker"), "--input", run.sim_log, "--output", run.offline, "-q"},
+                       run.dir + "/offline.txt"),
+            0);
+  return run;
+}
+
+tracker_status_t LastStatus(const std::string& path) {
+  tracker_status_t last;
+  lcm_util::LogReader r(path);
+  while (const lcm::LogEvent* ev = r.Next()) {
+    if (ev->channel == "TRACKER_STATUS") {
+      lcm_util::Decode(ev->data, static_cast<std::size_t>(ev->datalen), &last);
+    }
+  }
+  return last;
+}
+
+TEST(TrackerLiveTest, Fig4TurnLiveEveryVehicleTrackedNoIdentitySwitchSameAsOffline) {
+  VTRACK_REQUIRE_PRIVATE_NETNS();
+  const LiveRun run = RunLive("paper_fig4_turn", 16.0);
+  const EvalResult r = EvaluateTracks(run.live_log, run.live_log);
+  std::printf("live paper_fig4_turn: %s\n", Summary(r).c_str());
+  EXPECT_GT(r.due, 300);
+  EXPECT_EQ(r.matched, r.due) << (r.misses.empty() ? "" : r.misses.front());
+  EXPECT_EQ(r.id_switches, 0);
+  const tracker_status_t st = LastStatus(run.live_log);
+  EXPECT_EQ(st.scans_dropped, 0);
+  EXPECT_GE(st.scans_processed, 390);
+  // Fed live or from the log, the tracker gives the same ids and states (no message lost on the
+  // loopback bus: the results are bit-identical; the tolerance allows for nothing else).
+  EXPECT_GT(CompareTracks(TracksByUtime(run.live_log), TracksByUtime(run.offline), 1e-9), 390);
+}
+
+TEST(TrackerLiveTest, UrbanIntersectionLiveWith64LayerScans) {
+  VTRACK_REQUIRE_PRIVATE_NETNS();
+  // 12 s of the busy intersection: 2.8 MB scans at 10 Hz over the loopback bus.
+  const LiveRun run = RunLive("urban_intersection", 12.0);
+  const EvalResult r = EvaluateTracks(run.live_log, run.live_log);
+  std::printf("live urban_intersection (12 s): %s\n", Summary(r).c_str());
+  const tracker_status_t st = LastStatus(run.live_log);
+  std::printf("tracker: %lld scans received, %lld processed, median latency %.1f ms\n",
+              static_cast<long long>(st.scans_received), static_cast<long long>(st.scans_processed),
+              st.median_latency_ms);
+  EXPECT_GE(st.scans_processed, 110);  // of 120: the large socket buffer keeps (nearly) all
+  EXPECT_GT(r.due, 500);
+  // Open (tracker/README.md): on this scene not every vehicle is tracked yet; the live run must
+  // do as well as the offline run of the same lap.
+  const EvalResult off = EvaluateTracks(run.sim_log, run.offline);
+  std::printf("offline urban_intersection (12 s): %s\n", Summary(off).c_str());
+  EXPECT_GE(r.matched, off.matched * 95 / 100);
+  EXPECT_EQ(r.max_hyps_not_moving, 1);
+  EXPECT_LE(r.max_hyps_moving, 4);
+  std::filesystem::remove(run.sim_log);
+  std::filesystem::remove(run.live_log);
+}
+
+TEST(TrackerLiveTest, LogPlayedLiveGivesTheSameTracksAsOffline) {
+  VTRACK_REQUIRE_PRIVATE_NETNS();
+  const std::string dir = ScratchDir("tracker_logplayer");
+  const std::string sim = dir + "/sim.lcm", offline = dir + "/offline.lcm", live = dir + "/live.lcm";
+  ASSERT_EQ(RunCommand({Bin("vtrack-sim-log"), "--scenario", "paper_fig4_turn", "--duration", "8",
+                        "--out", sim, "-q"}, dir + "/sim.txt"), 0);
+  ASSERT_EQ(RunCommand({Bin("vtrack-tracker"), "--input", sim, "--output", offline, "-q"},
+                       dir + "/offline.txt"), 0);
+  {
+    Subprocess logger({"lcm-logger", "-q", "-f", "-c", "TRACKS", kLoggerUrl, live}, dir + "/logger.txt");
+    Subprocess tracker({Bin("vtrack-tracker")}, dir + "/tracker.txt");
+    std::this_thread::sleep_for(1s);
+    const int rc = RunCommand({"lcm-logplayer", "-l", "udpm://239.255.76.67:7667?ttl=0", sim},
+                              dir + "/player.txt", 60s);
+    EXPECT_EQ(rc, 0) << ReadFile(dir + "/player.txt");
+    std::this_thread::sleep_for(1s);
+    EXPECT_EQ(tracker.Stop(), 0);
+    std::this_thread::sleep_for(300ms);
+    logger.Stop();
+  }
+  // Stated tolerance: identical ids, states within 1e-9 (nothing is lost on loopback; the
+  // tracker depends on message contents and order only).
+  EXPECT_GT(CompareTracks(TracksByUtime(live), TracksByUtime(offline), 1e-9), 190);
+}
+
+}  // namespace
+}  // namespace vtrack::testing

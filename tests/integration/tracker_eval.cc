@@ -62,6 +62,7 @@ EvalResult EvaluateTracks(const std::string& truth_log, const std::string& track
   }
   EvalResult res;
   std::map<std::int64_t, std::int64_t> first_seen;  // vehicle -> utime of first returns
+  std::map<std::int64_t, std::int64_t> last_seen;   // vehicle -> utime of latest returns
   std::map<std::int64_t, double> per_n, per_pos, per_head;
   std::int64_t pairs = 0;  // every matched (vehicle, scan), due or not: for the RMSEs
   double pos_sq = 0.0, head_sq = 0.0, mover_head_sq = 0.0;
@@ -69,6 +70,7 @@ EvalResult EvaluateTracks(const std::string& truth_log, const std::string& track
   for (const auto& [utime, gt] : truth) {
     for (const auto& o : gt.objects) {
       if (o.num_points != 0 && !first_seen.count(o.id)) first_seen[o.id] = utime;
+      if (o.num_points != 0) last_seen[o.id] = utime;
     }
     const auto tl = tracks.find(utime);
     if (tl == tracks.end()) continue;
@@ -112,8 +114,10 @@ EvalResult EvaluateTracks(const std::string& truth_log, const std::string& track
       const bool matched = j >= 0 && j < static_cast<int>(cands.size()) &&
                            cost[static_cast<std::size_t>(i * cols + j)] < opt.gate;
       const auto fs = first_seen.find(o.id);
+      const auto ls = last_seen.find(o.id);
       const bool due = fs != first_seen.end() &&
-                       utime - fs->second >= static_cast<std::int64_t>(opt.in_view_delay_s * 1e6);
+                       utime - fs->second >= static_cast<std::int64_t>(opt.in_view_delay_s * 1e6) &&
+                       utime - ls->second <= static_cast<std::int64_t>(opt.occlusion_grace_s * 1e6);
       if (due) ++res.due;
       if (!matched) {
         if (due && res.misses.size() < 20) {

@@ -5,7 +5,8 @@
 // Per scan (joined by utime): ground-truth vehicles (car, van, truck, skid-steer) inside the
 // labelled region and within max_range of the ego are matched one to one with the tracks that
 // are not tentative, by centre distance (gate), minimum total distance. A vehicle counts as
-// "due" from in_view_delay_s after the first scan in which it had LADAR returns; a due vehicle
+// "due" from in_view_delay_s after the first scan in which it had LADAR returns, as long as it
+// had returns within the last occlusion_grace_s (an occluded vehicle is not due); a due vehicle
 // without a match is a miss. An identity switch is a change of the track id matched to a vehicle.
 #pragma once
 
@@ -20,6 +21,7 @@ struct EvalOptions {
   double max_range = 40.0;       // [m] vehicles farther from the ego are not scored
   double in_view_delay_s = 1.0;  // [s] grace period after a vehicle first has returns
   double gate = 2.0;             // [m] centre distance for a match
+  double occlusion_grace_s = 0.5;  // [s] a vehicle without returns for longer is not due
 };
 
 struct EvalResult {

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <string>
 
+#include "lcmtypes/util/process.h"
 #include "log_tools/kitti2lcm/converter.h"
 #include "sensor_driver/kitti/kitti_sequence.h"
 
@@ -85,6 +86,9 @@ int main(int argc, char** argv) {
     if (!quiet) std::cerr << "vtrack-kitti2lcm: " << msg << std::endl;
   };
 
+  // SIGINT/SIGTERM set a flag: an unpack in progress fails cleanly (tar gets the signal too), a
+  // conversion stops after the current frame; either way no partial output is left.
+  vtrack::lcm_util::InstallStopHandlers();
   try {
     const auto start = std::chrono::steady_clock::now();
     const vtrack::kitti::Sequence seq(seq_opt);
@@ -97,6 +101,11 @@ int main(int argc, char** argv) {
     }
     auto last_print = std::chrono::steady_clock::now() - std::chrono::hours(1);
     const auto progress = [&](int done, int total, std::int64_t bytes) {
+      // Ctrl-C: stop after this frame; the converter removes the partial log.
+      if (vtrack::lcm_util::StopRequested()) {
+        throw std::runtime_error("interrupted after frame " + std::to_string(done) + " of " +
+                                 std::to_string(total) + "; no log written");
+      }
       const auto now = std::chrono::steady_clock::now();
       if (quiet || (done != total && now - last_print < std::chrono::seconds(1))) return;
       last_print = now;

@@ -2,7 +2,9 @@
 // errors, and the real sequence 0000 (skipped when ../shared/data is absent).
 #include <gtest/gtest.h>
 
+#include <csignal>
 #include <filesystem>
+#include <thread>
 #include <fstream>
 #include <map>
 #include <set>
@@ -266,6 +268,30 @@ TEST(KittiConvertToolTest, RealSequenceFrames) {
   EXPECT_EQ(scans, 3);
   EXPECT_EQ(truths, 3);
   EXPECT_EQ(poses, 31);  // 300 ms of sweeps at 100 Hz, both ends included
+}
+
+// Ctrl-C during a conversion: the tool stops, says so, and leaves neither the log nor its partial.
+TEST(KittiConvertToolTest, InterruptLeavesNoPartialLog) {
+  const std::string kitti = vtrack::testing::KittiDir();
+  if (kitti.empty()) GTEST_SKIP() << "KITTI data not found (../shared/data/kitti_tracking_0000): skipped";
+  const std::string dir = ScratchDir("kitti_tool_interrupt");
+  const std::string out_file = dir + "/kitti.lcm";
+  const std::string log = dir + "/tool_output.txt";
+  vtrack::testing::Subprocess tool({Tool(), "--kitti", kitti, "--out", out_file, "--cache-dir",
+                                    BinDir() + "/../kitti_cache"}, log);
+  // Wait until the log is being written, then interrupt.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!fs::exists(out_file + ".partial") && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_TRUE(fs::exists(out_file + ".partial")) << ReadFile(log);
+  tool.Signal(SIGINT);
+  const auto status = tool.Wait(std::chrono::seconds(30));
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(*status, 1) << ReadFile(log);
+  EXPECT_NE(ReadFile(log).find("interrupted after frame"), std::string::npos) << ReadFile(log);
+  EXPECT_FALSE(fs::exists(out_file));
+  EXPECT_FALSE(fs::exists(out_file + ".partial"));
 }
 
 }  // namespace

@@ -4,24 +4,24 @@
 #include <cmath>
 #include <sstream>
 
+#include "tracker/lcm_convert.h"
+
 namespace vtrack::viewer {
 namespace {
 
-// A quaternion (w, x, y, z) close to unit length, normalised; nullopt otherwise.
-std::optional<Eigen::Quaterniond> UnitQuaternion(const double q[4], const char* what,
-                                                 std::string* why) {
-  const Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
-  const double norm = quat.norm();
-  if (!std::isfinite(norm) || norm < 0.9 || norm > 1.1) {
-    if (why) {
-      std::ostringstream os;
-      os << what << " quaternion (" << q[0] << ", " << q[1] << ", " << q[2] << ", " << q[3]
-         << ") is not a unit quaternion (norm " << norm << ")";
-      *why = os.str();
-    }
-    return std::nullopt;
+// True if the message's quaternion q is one the tracker's converters accept (within 1e-3 of unit
+// length: they normalise it; any other is passed on unchanged, and a zero quaternion would even
+// come out as the identity) and the converted transform m is finite.
+bool Rigid(const Eigen::Isometry3d& m, const char* what, const double q[4], std::string* why) {
+  const double norm = Eigen::Vector4d(q[0], q[1], q[2], q[3]).norm();
+  const bool ok = std::isfinite(norm) && std::abs(norm - 1.0) < 1e-3 && m.matrix().allFinite();
+  if (!ok && why) {
+    std::ostringstream os;
+    os << what << " (" << q[0] << ", " << q[1] << ", " << q[2] << ", " << q[3]
+       << ") or position is not a rigid transform (quaternion not of unit length, or not finite)";
+    *why = os.str();
   }
-  return quat.normalized();
+  return ok;
 }
 
 Eigen::Matrix3d RowMajor3(const double m[9]) {
@@ -42,42 +42,18 @@ bool PositiveFinite(double v) { return std::isfinite(v) && v > 0.0; }
 }  // namespace
 
 std::optional<Eigen::Isometry3d> PoseFromMsg(const vtrack::pose_t& msg, std::string* why) {
-  const Eigen::Vector3d pos(msg.pos[0], msg.pos[1], msg.pos[2]);
-  if (!pos.allFinite()) {
-    if (why) *why = "pose position is not finite";
-    return std::nullopt;
-  }
-  const auto q = UnitQuaternion(msg.orientation, "pose orientation", why);
-  if (!q) return std::nullopt;
-  Eigen::Isometry3d world_from_body = Eigen::Isometry3d::Identity();
-  world_from_body.linear() = q->toRotationMatrix();
-  world_from_body.translation() = pos;
-  return world_from_body;
+  const EgoPose pose = PoseFromLcm(msg);
+  if (!Rigid(pose.world_from_body, "pose orientation", msg.orientation, why)) return std::nullopt;
+  return pose.world_from_body;
 }
 
 std::optional<LadarScan> ScanFromMsg(const vtrack::ladar_scan_t& msg, std::string* why) {
-  const Eigen::Vector3d pos(msg.sensor_pos[0], msg.sensor_pos[1], msg.sensor_pos[2]);
-  if (!pos.allFinite()) {
-    if (why) *why = "scan sensor_pos is not finite";
+  // The tracker's conversion moves the arrays out of its argument: give it a copy, since the
+  // message may be shared with other frames.
+  LadarScan scan = ScanFromLcm(vtrack::ladar_scan_t(msg));
+  if (!Rigid(scan.body_from_sensor, "scan sensor_orientation", msg.sensor_orientation, why)) {
     return std::nullopt;
   }
-  const auto q = UnitQuaternion(msg.sensor_orientation, "scan sensor_orientation", why);
-  if (!q) return std::nullopt;
-  LadarScan scan;
-  scan.utime = msg.utime;
-  scan.seq = msg.seq;
-  scan.sensor_id = msg.sensor_id;
-  scan.body_from_sensor.linear() = q->toRotationMatrix();
-  scan.body_from_sensor.translation() = pos;
-  scan.sweep_duration_us = msg.sweep_duration_us;
-  scan.max_range = msg.max_range;
-  scan.num_rings = msg.num_rings;
-  scan.x = msg.x;
-  scan.y = msg.y;
-  scan.z = msg.z;
-  scan.intensity = msg.intensity;
-  scan.dt_us = msg.dt_us;
-  scan.ring = msg.ring;
   return scan;
 }
 
@@ -160,6 +136,7 @@ SceneTruth TruthFromMsg(const vtrack::object_t& msg) {
   g.speed = msg.speed;
   g.moving = msg.moving;
   g.in_labelled_region = msg.in_labelled_region;
+  g.is_clutter = msg.object_class >= vtrack::object_t::CLASS_WALL;
   return g;
 }
 

@@ -1,5 +1,6 @@
-// Converters from the bus messages (lcmtypes/) to the renderer's plain structs (viewer/scene.h)
-// and to the tracker core's scan and pose structs. Pure functions: no LCM bus, no I/O.
+// Converters from the bus messages (lcmtypes/) to the renderer's plain structs (viewer/scene.h),
+// and checked wrappers of the tracker's own scan and pose conversions. Pure functions: no LCM
+// bus, no I/O.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -17,12 +18,13 @@
 
 namespace vtrack::viewer {
 
-// world_from_body of a pose message, or nullopt (and *why) if the position is not finite or the
-// quaternion is not close to unit length (|q| outside [0.9, 1.1]); it is normalised otherwise.
+// world_from_body of a pose message, converted as the tracker converts it (tracker/lcm_convert.h:
+// a quaternion within 1e-3 of unit length is normalised), or nullopt (and *why, with the values)
+// if the result is not a rigid transform.
 std::optional<Eigen::Isometry3d> PoseFromMsg(const vtrack::pose_t& msg, std::string* why = nullptr);
 
-// The scan as the tracker core's struct (arrays copied). nullopt (and *why) if the mounting pose
-// is not finite or its quaternion not close to unit length.
+// The scan as the tracker core's struct, converted as the tracker converts it (arrays copied),
+// or nullopt (and *why) if the sensor's mounting is not a rigid transform.
 std::optional<LadarScan> ScanFromMsg(const vtrack::ladar_scan_t& msg, std::string* why = nullptr);
 
 // The reported state of a track; `past` is left empty (the trail is kept over time elsewhere),

@@ -108,6 +108,8 @@ int main(int argc, char** argv) {
        "scale in pixels per metre, following the ego vehicle")
       ("window", po::value(&window),
        "fixed world window XMIN,YMIN,XMAX,YMAX [m] instead of following the ego vehicle")
+      ("follow-track", po::value(&job.render.follow_track_id),
+       "centre on this track id instead of the ego vehicle (the ego while the track is absent)")
       ("hypotheses", po::bool_switch(&job.render.show_hypotheses),
        "draw every hypothesis of each mover (paper Fig. 6 b-d)")
       ("hide-clutter", po::bool_switch(), "do not draw tracks classed as clutter (\"other\")")
@@ -174,6 +176,10 @@ int main(int argc, char** argv) {
       if (wh[0] != job.render.width || wh[1] != job.render.height) {
         throw UsageError("--size '" + size + "': width and height must be whole pixels");
       }
+    }
+    if (vm.count("follow-track")) {
+      if (!window.empty()) throw UsageError("--window and --follow-track both given: choose one");
+      job.render.follow = RenderParams::Follow::kTrack;
     }
     if (!window.empty()) {
       if (!vm["zoom"].defaulted()) {

@@ -149,8 +149,12 @@ class Canvas {
   void FilledBox(const OrientedBox& box, const cv::Scalar& c) {
     if (!box.center.allFinite() || !std::isfinite(box.theta)) return;
     const auto corners = box.Corners();
+    FilledPolygon({corners.begin(), corners.end()}, c);
+  }
+
+  void FilledPolygon(const std::vector<Eigen::Vector2d>& world, const cv::Scalar& c) {
     std::vector<cv::Point> poly;
-    for (const auto& p : corners) {
+    for (const auto& p : world) {
       Eigen::Vector2d q = W(p), r = q;
       // Clip each corner's coordinates so a huge box cannot overflow the fixed-point conversion.
       if (!ClipSegment(-1e5, -1e5, 1e5, 1e5, &q, &r)) return;
@@ -404,10 +408,7 @@ int StateThickness(const SceneTrack& t) {
 std::string TrackLabel(const SceneTrack& t) {
   std::ostringstream os;
   os << '#' << t.id;
-  if (IsClutter(t)) {
-    os << " clutter";
-    return os.str();
-  }
+  if (IsClutter(t)) return os.str();
   os << ' ' << ModelName(t.model) << ' ' << FormatNumber(t.speed, 1) << " m/s  "
      << t.num_hypotheses << " hyp";
   if (t.status == TrackStatus::kTentative) os << " (new)";
@@ -415,18 +416,56 @@ std::string TrackLabel(const SceneTrack& t) {
   return os.str();
 }
 
-// Beside the rectangle: just right of its right-most corner, at the height of its top corner.
-cv::Point LabelOrigin(const Canvas& cv, const OrientedBox& box, const Font& font) {
-  double umax = -1e18, vmin = 1e18;
-  for (const auto& c : box.Corners()) {
-    const Eigen::Vector2d p = cv.W(c);
-    umax = std::max(umax, p.x());
-    vmin = std::min(vmin, p.y());
+// Places labels beside their rectangles without covering each other: the first free spot of
+// right-top, right-bottom, left-top, left-bottom, above, below; a label with no free spot is
+// tried in its short form and otherwise left out (a busy scene stays readable).
+class LabelPlacer {
+ public:
+  LabelPlacer(cv::Mat* image, const Canvas& canvas) : img_(*image), cv_(canvas) {}
+
+  // Returns false if no spot was free.
+  bool Place(const OrientedBox& box, const std::vector<std::string>& texts, const Font& font,
+             const cv::Scalar& c, bool veil) {
+    double umin = 1e18, umax = -1e18, vmin = 1e18, vmax = -1e18;
+    for (const auto& k : box.Corners()) {
+      const Eigen::Vector2d p = cv_.W(k);
+      if (!p.allFinite()) return false;
+      umin = std::min(umin, p.x());
+      umax = std::max(umax, p.x());
+      vmin = std::min(vmin, p.y());
+      vmax = std::max(vmax, p.y());
+    }
+    // Far outside the image: nothing to label.
+    if (umax < -200.0 || umin > img_.cols + 200.0 || vmax < -200.0 || vmin > img_.rows + 200.0) {
+      return false;
+    }
+    for (const std::string& text : texts) {
+      int baseline = 0;
+      const cv::Size s = font.Size(text, &baseline);
+      const double w = s.width, h = s.height;
+      const Eigen::Vector2d candidates[] = {
+          {umax + 6.0, vmin + h},    {umax + 6.0, vmax},         {umin - 6.0 - w, vmin + h},
+          {umin - 6.0 - w, vmax},    {umin, vmin - 6.0 - baseline}, {umin, vmax + h + 6.0}};
+      for (const auto& o : candidates) {
+        const cv::Point org(static_cast<int>(o.x()), static_cast<int>(o.y()));
+        const cv::Rect r(org.x - 2, org.y - s.height - 3, s.width + 4, s.height + baseline + 5);
+        if (std::any_of(taken_.begin(), taken_.end(),
+                        [&](const cv::Rect& t) { return (t & r).area() > 0; })) {
+          continue;
+        }
+        taken_.push_back(r);
+        Text(img_, font, text, org, c, veil);
+        return true;
+      }
+    }
+    return false;
   }
-  const double h = font.Size("Ag").height;
-  return {static_cast<int>(std::clamp(umax + 6.0, -1e6, 1e6)),
-          static_cast<int>(std::clamp(vmin + h, -1e6, 1e6))};
-}
+
+ private:
+  cv::Mat& img_;
+  const Canvas& cv_;
+  std::vector<cv::Rect> taken_;
+};
 
 }  // namespace
 
@@ -463,7 +502,13 @@ View MakeView(const RenderParams& params, const Scene& scene) {
     return p.allFinite() && p.cwiseAbs().maxCoeff() < 1e7;
   };
   Eigen::Vector2d center = Eigen::Vector2d::Zero();
-  if (scene.ego && plausible(scene.ego->position)) {
+  const auto followed = std::find_if(scene.tracks.begin(), scene.tracks.end(), [&](const auto& t) {
+    return params.follow == RenderParams::Follow::kTrack && t.id == params.follow_track_id &&
+           plausible(t.box.center);
+  });
+  if (followed != scene.tracks.end()) {
+    center = followed->box.center;
+  } else if (scene.ego && plausible(scene.ego->position)) {
     center = scene.ego->position;
   } else {
     Eigen::Vector2d sum = Eigen::Vector2d::Zero();
@@ -543,9 +588,12 @@ void Render(const Scene& scene, const RenderParams& params, const View& view, cv
   }
 
   // Ground truth: the true path and the true box, thin red.
-  const bool draw_truth = params.show_truth && !scene.truths.empty();
+  const bool draw_truth =
+      params.show_truth && std::any_of(scene.truths.begin(), scene.truths.end(),
+                                       [](const SceneTruth& g) { return !g.is_clutter; });
   if (draw_truth) {
     for (const auto& g : scene.truths) {
+      if (g.is_clutter) continue;  // walls, poles, bushes: nothing to compare a track with
       const cv::Scalar& c = g.in_labelled_region ? color::kTruth : color::kTruthOutside;
       cv.Polyline(g.path, c, 1, /*closed=*/false);
       cv.Box(g.box, c, 1);
@@ -560,13 +608,13 @@ void Render(const Scene& scene, const RenderParams& params, const View& view, cv
   if (scene.ego) {
     cv.Polyline(scene.ego->past, color::kEgoPath, 2, /*closed=*/false);
     cv.FilledBox(scene.ego->box, color::kEgo);
-    // A white chevron marks the front of the ego vehicle.
+    // A white triangle marks the front of the ego vehicle, when it is big enough to see.
     const OrientedBox& b = scene.ego->box;
-    if (b.center.allFinite() && std::isfinite(b.theta)) {
-      const Eigen::Vector2d tip = b.center + 0.4 * b.length * b.Axis();
-      const Eigen::Vector2d back = b.center + 0.05 * b.length * b.Axis();
-      cv.Line(back + 0.3 * b.width * b.Normal(), tip, cv::Scalar(255, 255, 255), 2);
-      cv.Line(back - 0.3 * b.width * b.Normal(), tip, cv::Scalar(255, 255, 255), 2);
+    if (b.center.allFinite() && std::isfinite(b.theta) && b.length * cv.view().px_per_m >= 24.0) {
+      const Eigen::Vector2d tip = b.center + 0.42 * b.length * b.Axis();
+      const Eigen::Vector2d base = b.center + 0.12 * b.length * b.Axis();
+      cv.FilledPolygon({tip, base + 0.3 * b.width * b.Normal(), base - 0.3 * b.width * b.Normal()},
+                       cv::Scalar(255, 255, 255));
     }
   }
 
@@ -643,9 +691,26 @@ void Render(const Scene& scene, const RenderParams& params, const View& view, cv
   }
 
   if (params.show_labels) {
-    for (const auto* t : tracks) {
-      if (!t->box.center.allFinite()) continue;
-      Text(*image, font, TrackLabel(*t), LabelOrigin(cv, t->box, font), color::kText);
+    // Movers first, then confirmed vehicles, then the rest; clutter last, small and grey.
+    auto rank = [](const SceneTrack& t) {
+      if (IsClutter(t)) return 3;
+      if (t.moving) return 0;
+      return t.status == TrackStatus::kConfirmed ? 1 : 2;
+    };
+    std::vector<const SceneTrack*> order = tracks;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](const auto* a, const auto* b) { return rank(*a) < rank(*b); });
+    Font small = font;
+    small.scale *= 0.85;
+    LabelPlacer labels(image, cv);
+    for (const auto* t : order) {
+      if (IsClutter(*t)) {
+        labels.Place(t->box, {TrackLabel(*t)}, small, color::kGridText, false);
+      } else {
+        std::ostringstream id;  // (not "#" + std::to_string: GCC 12 warns falsely, -Wrestrict)
+        id << '#' << t->id;
+        labels.Place(t->box, {TrackLabel(*t), id.str()}, font, color::kText, true);
+      }
     }
   }
 

@@ -2,7 +2,8 @@
 //
 // What is drawn, back to front, and in which colour (viewer/README.md has the same table):
 //   metric grid                                light grey, labelled in world metres
-//   true trajectory and true boxes             red, thin (where ground truth exists)
+//   true trajectory and true boxes             red, thin (where ground truth exists; not for
+//                                              walls, poles and bushes)
 //   LADAR hits                                 grey dots; points associated with a track darker
 //   ego vehicle and its recent path            blue (filled rectangle, light-blue path)
 //   recent trajectory of each track            blue
@@ -22,6 +23,7 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
+#include <cstdint>
 #include <string>
 
 #include "viewer/scene.h"
@@ -53,12 +55,13 @@ inline const cv::Scalar kText(20, 20, 20);
 }  // namespace color
 
 struct RenderParams {
-  enum class Follow { kEgo, kWindow };
+  enum class Follow { kEgo, kWindow, kTrack };
 
   int width = 1280;                   // [px] frame width; even (video encoders need it)
   int height = 960;                   // [px] frame height; even
-  Follow follow = Follow::kEgo;       // [-] centre on the ego vehicle, or show a fixed window
-  double zoom = 10.0;                 // [px/m] scale when following the ego
+  Follow follow = Follow::kEgo;       // [-] centre on the ego vehicle, a fixed window, or a track
+  double zoom = 10.0;                 // [px/m] scale when following the ego or a track
+  std::int64_t follow_track_id = 0;   // [-] kTrack: the track to centre on (the ego while absent)
   Eigen::AlignedBox2d window{Eigen::Vector2d(-50, -50), Eigen::Vector2d(50, 50)};  // [m] kWindow
   double ellipse_sigma = 3.0;         // [-] covariance ellipses at this many standard deviations
   int point_size = 2;                 // [px] side of the square drawn for each LADAR hit
@@ -75,8 +78,9 @@ struct RenderParams {
   std::string FirstProblem() const;  // "" if valid
 };
 
-// The view a frame uses: centred on the ego (or, without one, on the tracks, the points, or the
-// origin, in that order) at `zoom`, or the fixed window.
+// The view a frame uses: the fixed window, or centred at `zoom` on the followed track if it is in
+// the scene, else on the ego (or, without one, on the mean of the tracks, of the points, or on
+// the origin, in that order).
 View MakeView(const RenderParams& params, const Scene& scene);
 
 // Renders the scene into a new width x height BGR image. Throws std::invalid_argument if the

@@ -82,6 +82,7 @@ struct SceneTruth {
   double speed = 0.0;                                 // [m/s]
   bool moving = false;
   bool in_labelled_region = true;
+  bool is_clutter = false;                            // [-] wall, pole, bush, other: not drawn
   std::vector<Eigen::Vector2d> path;                  // [m] true centres, oldest first (red)
 };
 

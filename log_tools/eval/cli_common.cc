@@ -1,6 +1,7 @@
 #include "log_tools/eval/cli_common.h"
 
 #include <cstdio>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -28,6 +29,9 @@ void AddEvalOptions(po::options_description* desc, EvalCliOptions* o) {
      "score only inside camera 2's horizontal view (needs --kitti-calib): KITTI's labelled region")
     ("horizons", po::value(&o->horizons)->default_value(o->horizons),
      "[s] prediction horizons, comma separated")
+    ("truth-time-offset", po::value(&o->truth_time_offset)->default_value(o->truth_time_offset),
+     "[s] the ground truth stamped u describes u + this; tracks are advanced to it before scoring. "
+     "'half-sweep' = half the LADAR sweep (KITTI logs)")
     ("truth-channel", po::value(&o->truth_channel)->default_value(o->truth_channel), "ground truth channel")
     ("tracks-channel", po::value(&o->tracks_channel)->default_value(o->tracks_channel), "tracks channel")
     ("pose-channel", po::value(&o->pose_channel)->default_value(o->pose_channel), "ego pose channel")
@@ -97,6 +101,16 @@ EvalParams MakeEvalParams(const EvalCliOptions& o) {
   p.region_range_m = o.region_range_m;
   p.region_fov_deg = o.region_fov_deg;
   p.horizons_s = ParseDoubleList("horizons", o.horizons);
+  if (o.truth_time_offset == "half-sweep") {
+    p.truth_time_offset_s = std::numeric_limits<double>::quiet_NaN();
+  } else {
+    const auto v = ParseDoubleList("truth-time-offset", o.truth_time_offset);
+    if (v.size() != 1) {
+      throw std::invalid_argument("--truth-time-offset: one number or 'half-sweep', got '" +
+                                  o.truth_time_offset + "'");
+    }
+    p.truth_time_offset_s = v[0];
+  }
   p.truth_channel = o.truth_channel;
   p.tracks_channel = o.tracks_channel;
   p.pose_channel = o.pose_channel;

@@ -23,6 +23,7 @@ struct EvalCliOptions {
   double region_fov_deg = 360.0;
   bool region_camera = false;
   std::string horizons = "1,2,3";
+  std::string truth_time_offset = "0";
   std::string truth_channel = "GROUND_TRUTH";
   std::string tracks_channel = "TRACKS";
   std::string pose_channel = "EGO_POSE";

@@ -214,6 +214,7 @@ int RunCompare(const CompareOptions& o) {
         kopt.kitti_calib = FindKittiCalib(o, item);
         kopt.region_camera = true;
         kopt.region_range_m = o.kitti_range_m;
+        kopt.truth_time_offset = "half-sweep";  // labels are half a sweep after the scan's utime
         params = MakeEvalParams(kopt);
       }
       if (o.reuse && fs::is_regular_file(run)) {

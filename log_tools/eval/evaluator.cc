@@ -93,6 +93,19 @@ std::optional<Eigen::Vector2d> PredictedAt(const vtrack::track_t& tr, double h) 
   return p;
 }
 
+// A track's centre and orientation dt seconds after its utime, at constant velocity and yaw rate.
+struct TrackPose {
+  double x, y, theta;
+};
+TrackPose Advance(const vtrack::track_t& tr, double dt) {
+  if (dt == 0.0) return {tr.x, tr.y, tr.theta};
+  const double speed = std::isfinite(tr.speed) ? tr.speed : 0.0;
+  const double heading = std::isfinite(tr.velocity_heading) ? tr.velocity_heading : tr.theta;
+  const double yaw_rate = std::isfinite(tr.yaw_rate) ? tr.yaw_rate : 0.0;
+  return {tr.x + speed * std::cos(heading) * dt, tr.y + speed * std::sin(heading) * dt,
+          WrapToPi(tr.theta + yaw_rate * dt)};
+}
+
 const vtrack::object_t* FindObject(const vtrack::object_list_t& list, std::int64_t id) {
   for (const auto& o : list.objects) {
     if (o.id == id) return &o;
@@ -152,6 +165,9 @@ std::string EvalParams::Validate() const {
     os << "moving_speed_mps must be >= 0, got " << moving_speed_mps;
   }
   for (const double h : horizons_s) positive("horizons_s", h);
+  if (os.tellp() == 0 && std::isinf(truth_time_offset_s)) {
+    os << "truth_time_offset_s must be finite (or NaN for half the sweep), got " << truth_time_offset_s;
+  }
   if (os.tellp() == 0 && region_camera && region_camera->width <= 0) {
     os << "region_camera.width must be > 0, got " << region_camera->width;
   }
@@ -285,6 +301,16 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params) {
     throw std::runtime_error("a scoring region (range/field of view) needs the ego pose, but the "
                              "logs hold no pose_t on channel '" + params.pose_channel + "'");
   }
+  s.truth_time_offset_s = params.truth_time_offset_s;
+  if (std::isnan(s.truth_time_offset_s)) {
+    if (!data.sweep_duration_us) {
+      throw std::runtime_error("the truth time offset 'half the sweep' needs a LADAR_SCAN on channel '" +
+                               params.scan_channel + "' in the logs");
+    }
+    s.truth_time_offset_s = 0.5e-6 * static_cast<double>(*data.sweep_duration_us);
+  }
+  const double dt = s.truth_time_offset_s;
+  const auto offset_us = static_cast<std::int64_t>(std::llround(dt * 1e6));
   const double half_fov = DegToRad(params.region_fov_deg) / 2.0;
   Eigen::Isometry3d body_from_sensor = Eigen::Isometry3d::Identity();
   if (params.region_camera) {
@@ -301,6 +327,7 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params) {
   std::vector<ScoringFrame> frames;
   std::vector<std::vector<const vtrack::object_t*>> frame_truth;
   std::vector<std::vector<const vtrack::track_t*>> frame_tracks;
+  std::vector<std::vector<TrackPose>> frame_track_poses;  // advanced by the truth time offset
 
   for (const auto& [utime, list] : track_lists) {
     const auto gt_it = data.truth.find(utime);
@@ -366,6 +393,7 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params) {
 
     // Candidate tracks, then drop those paired with ignored truth, or unpaired outside the region.
     std::vector<const vtrack::track_t*> candidates;
+    std::vector<TrackPose> candidate_pose;
     std::set<std::int64_t> track_ids;
     for (const auto& tr : list.tracks) {
       const bool status_ok = tr.status == vtrack::track_t::STATUS_CONFIRMED ||
@@ -380,35 +408,40 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params) {
         continue;
       }
       candidates.push_back(&tr);
+      candidate_pose.push_back(Advance(tr, dt));
     }
     Eigen::MatrixXd cost(candidates.size(), all_truth.size());
     for (std::size_t j = 0; j < candidates.size(); ++j) {
       for (std::size_t i = 0; i < all_truth.size(); ++i) {
-        const double d = std::hypot(candidates[j]->x - all_truth[i]->x,
-                                    candidates[j]->y - all_truth[i]->y);
+        const double d = std::hypot(candidate_pose[j].x - all_truth[i]->x,
+                                    candidate_pose[j].y - all_truth[i]->y);
         cost(j, i) = d < params.gate_m ? d : kInf;
       }
     }
     std::vector<int> partner(candidates.size(), -1);
     for (const auto& [j, i] : GatedAssignment(cost)) partner[j] = i;
     std::vector<const vtrack::track_t*> kept;
+    std::vector<TrackPose> kept_pose;
     for (std::size_t j = 0; j < candidates.size(); ++j) {
       const vtrack::track_t* tr = candidates[j];
       if (partner[j] >= 0 && !truth_scored[partner[j]]) {
         ++s.ignored_track_detections;
         continue;
       }
-      if (partner[j] < 0 && !in_region(tr->x, tr->y, std::nullopt)) {
+      const TrackPose& tp = candidate_pose[j];
+      if (partner[j] < 0 && !in_region(tp.x, tp.y, std::nullopt)) {
         ++s.outside_region_track_detections;
         continue;
       }
       kept.push_back(tr);
+      kept_pose.push_back(tp);
       f.track_ids.push_back(tr->id);
-      f.track_xy.emplace_back(tr->x, tr->y);
+      f.track_xy.emplace_back(tp.x, tp.y);
     }
     frames.push_back(std::move(f));
     frame_truth.push_back(std::move(scored));
     frame_tracks.push_back(std::move(kept));
+    frame_track_poses.push_back(std::move(kept_pose));
   }
   for (const auto& [utime, gt] : data.truth) {
     if (!track_lists.count(utime)) ++s.scans_without_tracks;
@@ -465,6 +498,7 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params) {
     for (const Match& m : s.clear.matches[t]) {
       const vtrack::object_t& o = *frame_truth[t][m.gt];
       const vtrack::track_t& tr = *frame_tracks[t][m.track];
+      const TrackPose& tp = frame_track_poses[t][m.track];
       PairSample ps;
       ps.t_s = ts;
       ps.utime = f.utime;
@@ -473,7 +507,7 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params) {
       ps.id_switch = m.id_switch;
       c.id_switches += m.id_switch ? 1 : 0;
       ps.position_error_m = m.distance_m;
-      const double dth = AngleDiff(tr.theta, o.yaw);
+      const double dth = AngleDiff(tp.theta, o.yaw);
       ps.heading_flipped = std::abs(dth) > kPi / 2.0;
       const double folded = ps.heading_flipped ? WrapToPi(dth + kPi) : dth;
       ps.heading_error_deg = RadToDeg(folded);
@@ -496,7 +530,7 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params) {
                                  1e-9 * std::max(1.0, cov.cwiseAbs().maxCoeff())) {
         Eigen::LLT<Eigen::Matrix3d> llt(0.5 * (cov + cov.transpose()));
         if (llt.info() == Eigen::Success) {
-          const Eigen::Vector3d e(tr.x - o.x, tr.y - o.y, folded);
+          const Eigen::Vector3d e(tp.x - o.x, tp.y - o.y, folded);
           ps.nees = e.dot(llt.solve(e));
         }
       }
@@ -506,7 +540,10 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params) {
       for (std::size_t h = 0; h < nh; ++h) {
         const auto p = PredictedAt(tr, params.horizons_s[h]);
         if (!p) continue;
-        const auto when = f.utime + static_cast<std::int64_t>(std::llround(params.horizons_s[h] * 1e6));
+        // The truth list stamped u describes u + offset: the truth at time utime + k is the list
+        // time utime + k - offset.
+        const auto when =
+            f.utime + static_cast<std::int64_t>(std::llround(params.horizons_s[h] * 1e6)) - offset_us;
         const auto truth_then = TruthAt(data.truth, o.id, when, params.max_truth_gap_s);
         if (!truth_then) continue;
         ps.prediction_error_m[h] = (*p - *truth_then).norm();

@@ -81,6 +81,11 @@ struct EvalParams {
   double moving_speed_mps = 0.5;    // [m/s] truth faster than this counts as moving (L error); >= 0
   double max_pose_gap_s = 0.5;      // [s] ego pose extrapolated at most this far for the region
   std::optional<CameraRegion> region_camera;  // score only inside this camera's view (also)
+  // [s] the ground truth of a scan describes the objects at utime + this (KITTI logs: the labels
+  // are half a sweep after the scan's utime, sensor_driver/kitti/kitti_sequence.h). Tracks are
+  // advanced to that time at constant velocity and yaw rate before they are scored. NaN = half
+  // the sweep duration of the log's LADAR_SCAN. Default 0: truth at the scan's utime.
+  double truth_time_offset_s = 0.0;
 
   bool RegionEnabled() const {
     return region_range_m > 0.0 || region_fov_deg < 360.0 || region_camera.has_value();
@@ -175,6 +180,7 @@ struct EvalSummary {
   std::vector<ScanCounts> per_scan;
   std::vector<TrackRow> per_track;
   std::map<std::string, std::int64_t> problems;  // skipped input, by reason (from the logs too)
+  double truth_time_offset_s = 0.0;       // [s] the offset applied (see EvalParams)
 };
 
 // The 95 % quantile of chi-square with 3 degrees of freedom.

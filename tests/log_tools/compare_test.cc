@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "lcmtypes/util/log_reader.h"
 #include "tests/log_tools/synthetic_run.h"
 #include "tests/support/subprocess.h"
 #include "tests/support/test_env.h"
@@ -107,6 +108,9 @@ TEST_F(CompareTest, ThreeModesOnTwoScenariosAndKitti) {
   EXPECT_EQ(j["kitti_0000"]["mht"]["false_positives"].as<int>(), 0);
   EXPECT_TRUE(j["kitti_0000"]["mht"]["params"]["region_camera"].as<bool>());
   EXPECT_NEAR(j["kitti_0000"]["mht"]["params"]["region_range_m"].as<double>(), 40.0, 1e-12);
+  // The labels are half a sweep (of the fake's 100 ms) after the scan's utime.
+  EXPECT_NEAR(j["kitti_0000"]["mht"]["params"]["truth_time_offset_s"].as<double>(), 0.05, 1e-12);
+  EXPECT_NEAR(j["alpha"]["mht"]["params"]["truth_time_offset_s"].as<double>(), 0.0, 1e-12);
 
   for (const char* png : {"alpha_modes.png", "beta_modes.png", "kitti_0000_modes.png"}) {
     EXPECT_FALSE(cv::imread(plots + "/" + png).empty()) << png;
@@ -142,12 +146,23 @@ TEST(CompareRealToolsTest, PaperScenarioThroughTheRealSimulatorAndTracker) {
                              "--work-dir", dir + "/work", "--quiet"},
                             dir + "/out.txt", std::chrono::minutes(5));
   ASSERT_EQ(rc, 0) << ReadFile(dir + "/out.txt");
+  // The tracker answers every scan of a log it reads offline, so every ground-truth scan of the
+  // simulator's log is scored, in every mode.
+  int truth_scans = 0;
+  vtrack::lcm_util::LogReader reader(dir + "/work/paper_fig4_turn/run.lcm");
+  while (const lcm::LogEvent* ev = reader.Next()) truth_scans += ev->channel == "GROUND_TRUTH";
+  ASSERT_GT(truth_scans, 0);
   const YAML::Node j = YAML::LoadFile(json);
   for (const char* mode : {"ism", "vasm", "mht"}) {
     const YAML::Node s = j["paper_fig4_turn"][mode];
     ASSERT_TRUE(s.IsMap()) << mode;
-    EXPECT_GT(s["scans"].as<int>(), 0) << mode;
+    EXPECT_EQ(s["mode"].as<std::string>(), mode);
+    EXPECT_EQ(s["scans"].as<int>(), truth_scans) << mode;
+    EXPECT_EQ(s["scans_without_tracks"].as<int>(), 0) << mode;
     EXPECT_GE(s["gt_objects"].as<int>(), 1) << mode;
+    EXPECT_LE(s["mota"].as<double>(), 1.0) << mode;
+    const double hota = s["hota"].as<double>();
+    EXPECT_TRUE(hota >= 0.0 && hota <= 1.0) << mode << " " << hota;
   }
 }
 

@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "lcmtypes/util/log_reader.h"
 #include "log_tools/eval/evaluator.h"
+#include "vtrack/ladar_scan_t.hpp"
 #include "tests/log_tools/synthetic_run.h"
 #include "tests/support/test_env.h"
 
@@ -168,6 +170,60 @@ TEST_F(EvaluatorTest, ModesAndDuplicates) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("tracks_changed.lcm"), std::string::npos) << e.what();
   }
+}
+
+TEST_F(EvaluatorTest, TruthTimeOffset) {
+  // Ground truth stamped u but describing u + 50 ms (as KITTI logs): car A's truth is its state
+  // 50 ms later; track 1 reports A's exact state at u (centre, speed, velocity heading, yaw rate)
+  // and predicts A's exact future centre. Scored without the offset, track 1 is 50 ms behind
+  // (about kSpeed * 0.05 = 0.25 m); with the offset (half the 100 ms sweep of the log's scan) it
+  // is advanced to u + 50 ms and the errors nearly vanish (what remains is the straight-line
+  // advance against the arc, v^2 dt^2 / (2 R) = 1.6 mm).
+  const std::string run = dir_ + "/run_offset.lcm", tracks = dir_ + "/tracks_offset.lcm";
+  {
+    lcm_util::LogWriter w(run);
+    vtrack::ladar_scan_t scan{};
+    scan.utime = vtrack::testing::kUtime0;
+    scan.sensor_orientation[0] = 1.0;
+    scan.sweep_duration_us = 100'000;
+    w.WriteMessage(scan.utime, "LADAR_SCAN", scan);
+    for (auto list : vtrack::testing::SyntheticTruth()) {
+      const double t = static_cast<double>(list.utime - vtrack::testing::kUtime0) * 1e-6 + 0.05;
+      const auto a = vtrack::testing::CarA(t);
+      list.objects[0].x = a.centre.x();
+      list.objects[0].y = a.centre.y();
+      list.objects[0].yaw = a.yaw;
+      w.WriteMessage(list.utime, "GROUND_TRUTH", list);
+    }
+  }
+  {
+    lcm_util::LogWriter w(tracks);
+    for (auto list : vtrack::testing::SyntheticTracks("mht")) {
+      const double t = static_cast<double>(list.utime - vtrack::testing::kUtime0) * 1e-6;
+      const auto a = vtrack::testing::CarA(t);
+      auto& t1 = list.tracks[0];
+      t1.x = a.centre.x();
+      t1.y = a.centre.y();
+      t1.theta = a.yaw;
+      t1.speed = a.velocity.norm();
+      t1.velocity_heading = std::atan2(a.velocity.y(), a.velocity.x());
+      t1.yaw_rate = a.yaw_rate;
+      for (std::size_t k = 0; k < t1.pred_x.size(); ++k) t1.pred_x[k] -= 1.0;  // exact future
+      w.WriteMessage(list.utime, "TRACKS", list);
+    }
+  }
+  EvalParams params;
+  const LogData data = LoadLogs({run, tracks}, params);
+  const EvalSummary plain = Evaluate(data, params);
+  params.truth_time_offset_s = std::numeric_limits<double>::quiet_NaN();  // half the sweep
+  const EvalSummary shifted = Evaluate(data, params);
+  EXPECT_NEAR(shifted.truth_time_offset_s, 0.05, 1e-12);
+  const double lag = vtrack::testing::CarA(0).velocity.norm() * 0.05;
+  // Track 2 (on the parked car) is exact either way: RMSE over the two = lag / sqrt 2.
+  EXPECT_NEAR(plain.position_rmse_m, lag / std::sqrt(2.0), 0.01);
+  EXPECT_LT(shifted.position_rmse_m, 0.003);
+  EXPECT_GT(plain.prediction_error_m[0], 0.2);
+  EXPECT_LT(shifted.prediction_error_m[0], 0.01);
 }
 
 }  // namespace

@@ -176,6 +176,7 @@ TEST(Ekf, GatedMeasurementLeavesHypothesisUnchanged) {
   EXPECT_EQ(r.reason, UpdateStatus::kGated);
   EXPECT_NEAR(r.nis, 9.0 / 0.02, 1e-9);
   EXPECT_DOUBLE_EQ(r.gate, ekf.gate_nis());
+  EXPECT_LT((r.innovation_cov - 0.02 * Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), 1e-15);
   EXPECT_EQ(h.x, before.x);
   EXPECT_EQ(h.P, before.P);
 }

@@ -114,6 +114,7 @@ LiveStats LiveRenderer::stats() const {
   s.frames_skipped = frames_skipped_;
   s.frames_dropped = slot_.dropped();
   s.decode_errors = router_.total_decode_errors();
+  for (const auto& [channel, n] : router_.received()) s.messages += n;
   return s;
 }
 

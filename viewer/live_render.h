@@ -27,6 +27,7 @@ namespace vtrack::viewer {
 std::string WithReceiveBuffer(const std::string& url);
 
 struct LiveStats {
+  std::int64_t messages = 0;         // messages decoded on the renderer's channels
   std::int64_t frames_ready = 0;     // frames put together from the bus
   std::int64_t frames_rendered = 0;  // drawn and handed to the sink
   std::int64_t frames_dropped = 0;   // replaced by a newer frame before they could be drawn

@@ -277,7 +277,8 @@ int main(int argc, char** argv) {
         const auto now = std::chrono::steady_clock::now();
         if (duration_s > 0.0 && now - start >= std::chrono::duration<double>(duration_s)) break;
         if (!live.HandleOnce(100)) {
-          lcm_ok = false;
+          // A stop signal interrupts LCM's wait (EINTR): that is the normal end, not an error.
+          lcm_ok = vtrack::lcm_util::StopRequested();
           break;
         }
         if (!quiet && now - last_status >= std::chrono::seconds(10)) {

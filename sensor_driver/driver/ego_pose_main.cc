@@ -38,8 +38,10 @@ int main(int argc, char** argv) {
       "Pairs with vtrack-ladar-driver given the same scenario/KITTI options and --start-utime (or\n"
       "none); the two agree on time through the wall clock (sensor_driver/README.md).";
   po::variables_map vm;
+  vtrack::sim::SimCli cli;
   try {
     if (!vtrack::sim::ParseCommandLine(argc, argv, desc, usage, &vm)) return 0;
+    cli = vtrack::sim::ReadSimCli(vm);
     if (vm.count("scenario") == vm.count("kitti")) throw po::error("give exactly one of --scenario and --kitti");
     if (vm.count("poses") && vm.count("oxts")) throw po::error("give at most one of --poses and --oxts");
   } catch (const po::error& e) {
@@ -48,7 +50,6 @@ int main(int argc, char** argv) {
   }
   try {
     vtrack::lcm_util::InstallStopHandlers();
-    const vtrack::sim::SimCli cli = vtrack::sim::ReadSimCli(vm);
     auto lcm = vtrack::lcm_util::OpenLcm(vm["lcm-url"].as<std::string>());
     const std::string channel = vm["channel"].as<std::string>();
     vtrack::sim::RealtimeOptions ro;
@@ -57,7 +58,7 @@ int main(int argc, char** argv) {
     ro.stop_after_s = vm["stop-after"].as<double>();
     ro.name = "vtrack-ego-pose";
     ro.what = "poses";
-    ro.late_limit_s = 0.05;
+    ro.late_limit_s = 0.5;
     if (vm.count("quiet")) ro.progress_interval_s = 0.0;
 
     std::unique_ptr<vtrack::sim::Simulator> sim;

@@ -40,8 +40,10 @@ int main(int argc, char** argv) {
       "Run vtrack-ego-pose with the same scenario/KITTI options and --start-utime (or none) for\n"
       "the matching EGO_POSE; the two agree on time through the wall clock (sensor_driver/README.md).";
   po::variables_map vm;
+  vtrack::sim::SimCli cli;
   try {
     if (!vtrack::sim::ParseCommandLine(argc, argv, desc, usage, &vm)) return 0;
+    cli = vtrack::sim::ReadSimCli(vm);
     if (vm.count("scenario") == vm.count("kitti")) throw po::error("give exactly one of --scenario and --kitti");
     if (vm.count("poses") && vm.count("oxts")) throw po::error("give at most one of --poses and --oxts");
   } catch (const po::error& e) {
@@ -50,7 +52,6 @@ int main(int argc, char** argv) {
   }
   try {
     vtrack::lcm_util::InstallStopHandlers();
-    const vtrack::sim::SimCli cli = vtrack::sim::ReadSimCli(vm);
     auto lcm = vtrack::lcm_util::OpenLcm(vm["lcm-url"].as<std::string>());
     const std::string scan_channel = vm["scan-channel"].as<std::string>();
     const std::string truth_channel = vm.count("no-truth") ? "" : vm["truth-channel"].as<std::string>();
@@ -69,7 +70,7 @@ int main(int argc, char** argv) {
       auto t = std::make_unique<vtrack::sim::KittiScanTimeline>(
           vtrack::sim::KittiCliOptions(vm), lcm.get(), scan_channel, truth_channel);
       ro.lap_us = t->LapUs();
-      ro.late_limit_s = 0.1;
+      ro.late_limit_s = 0.5;
       std::fprintf(stderr, "vtrack-ladar-driver: KITTI sequence %s, %d frames\n",
                    vm["sequence"].as<std::string>().c_str(), t->Count());
       timeline = std::move(t);
@@ -79,7 +80,7 @@ int main(int argc, char** argv) {
     } else {
       sim = vtrack::sim::MakeSimulator(cli);
       ro.lap_us = sim->RunDurationUs();
-      ro.late_limit_s = 1.0 / sim->sensor().rate_hz;
+      ro.late_limit_s = 0.5;
       std::fprintf(stderr,
                    "vtrack-ladar-driver: scenario '%s', sensor '%s' (%d layers, %.1f Hz, %d "
                    "columns), seed %llu, %d scans per run\n",

@@ -38,7 +38,9 @@ struct RealtimeOptions {
   std::optional<std::int64_t> start_utime;  // [us] U; unset = 0 (the wall-clock grid)
   std::int64_t laps = 0;                    // laps to run from the first one; 0 = until stopped
   double stop_after_s = 0.0;                // [s] stop after this much wall time; 0 = never
-  double late_limit_s = 0.1;                // [s] an item due longer ago than this is skipped
+  double late_limit_s = 0.5;                // [s] an item overdue by more than this is skipped;
+                                            // one overdue by less is still published (a starved
+                                            // process catches up in a burst, losing nothing)
   std::string name = "vtrack";              // prefix of progress lines on stderr
   std::string what = "messages";            // what is published, for progress lines
   double progress_interval_s = 5.0;         // [s] between progress lines; 0 = none

@@ -43,6 +43,9 @@ SimCli ReadSimCli(const po::variables_map& vm) {
   if (vm.count("scenario")) c.scenario = vm["scenario"].as<std::string>();
   get("duration", &c.duration);
   get("start-utime", &c.start_utime);
+  if (c.start_utime && *c.start_utime < 0) {
+    throw po::error("--start-utime = " + std::to_string(*c.start_utime) + ": must be >= 0");
+  }
   get("seed", &c.run.seed);
   if (vm.count("sensor")) c.run.sensor = vm["sensor"].as<std::string>();
   get("range-noise", &c.run.range_noise);

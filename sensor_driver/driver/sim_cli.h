@@ -27,7 +27,8 @@ void AddSensorOptions(boost::program_options::options_description* desc);
 // --pose-rate, --pose-noise-pos, --pose-noise-yaw-deg.
 void AddPoseOptions(boost::program_options::options_description* desc);
 
-// Reads the options above that were defined and given.
+// Reads the options above that were defined and given. Throws boost::program_options::error for
+// a value no scenario could accept (e.g. a negative --start-utime).
 SimCli ReadSimCli(const boost::program_options::variables_map& vm);
 
 // Resolves and loads the scenario and applies the overrides. Throws (ScenarioError,

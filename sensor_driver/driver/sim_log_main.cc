@@ -35,8 +35,10 @@ int main(int argc, char** argv) {
       "vtrack-ego-pose (same --start-utime and seed) recorded by lcm-logger would have.\n\n"
       "usage: vtrack-sim-log --scenario NAME --out run.lcm [--seed N] [--sensor S] [...]";
   po::variables_map vm;
+  vtrack::sim::SimCli cli;
   try {
     if (!vtrack::sim::ParseCommandLine(argc, argv, desc, usage, &vm)) return 0;
+    cli = vtrack::sim::ReadSimCli(vm);
     if (!vm.count("scenario")) throw po::error("--scenario is required");
     if (!vm.count("out") && !vm.count("describe")) throw po::error("--out is required");
   } catch (const po::error& e) {
@@ -45,7 +47,6 @@ int main(int argc, char** argv) {
   }
   const bool quiet = vm.count("quiet") > 0;
   try {
-    const vtrack::sim::SimCli cli = vtrack::sim::ReadSimCli(vm);
     auto sim = vtrack::sim::MakeSimulator(cli);
     if (vm.count("describe")) {
       vtrack::sim::Describe(*sim, std::cout);

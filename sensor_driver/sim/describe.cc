@@ -54,7 +54,7 @@ PathSummary Summarise(const VehicleMotion& m, double duration) {
 struct Footprint {
   Eigen::Vector2d c;
   double yaw, half_l, half_w, radius;
-  std::string name;
+  int index;  // into scene.objects; -1 for the ego
 };
 
 // Separating-axis test of two rectangles; returns the smallest overlap along the four axes
@@ -80,31 +80,39 @@ double OverlapDepth(const Footprint& p, const Footprint& q) {
 
 std::vector<Overlap> FindOverlaps(const Scenario& sc, double step, double tolerance) {
   std::vector<Overlap> found;
-  std::set<std::pair<std::string, std::string>> seen;
+  std::set<std::pair<int, int>> seen;
   const Scene& scene = sc.scene;
-  auto footprint = [&](const SceneObject& o, double t) {
-    const ObjectState s = scene.StateOf(o, t);
-    return Footprint{s.center, s.yaw, 0.5 * o.length, 0.5 * o.width, o.BoundingRadius(),
-                     Line("%s %lld", ObjectClassName(o.object_class), static_cast<long long>(o.id))};
+  auto name = [&](int i) {
+    if (i < 0) return std::string("ego");
+    const SceneObject& o = scene.objects[i];
+    return Line("%s %lld", ObjectClassName(o.object_class), static_cast<long long>(o.id));
   };
+  std::vector<Footprint> all(scene.objects.size());
+  std::vector<int> movers;
+  for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+    if (scene.objects[i].moving()) movers.push_back(static_cast<int>(i));
+  }
   for (double t = 0.0; t <= sc.duration + 1e-9; t += step) {
-    std::vector<Footprint> movers, all;
-    for (const auto& o : scene.objects) {
-      all.push_back(footprint(o, t));
-      if (o.moving()) movers.push_back(all.back());
+    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+      const SceneObject& o = scene.objects[i];
+      if (t > 0.0 && !o.moving()) continue;  // static footprints are computed once
+      const ObjectState s = scene.StateOf(o, t);
+      all[i] = {s.center, s.yaw, 0.5 * o.length, 0.5 * o.width, o.BoundingRadius(), static_cast<int>(i)};
     }
     const MotionState e = scene.EgoAt(t);
-    movers.push_back({e.center, e.yaw, 0.5 * scene.ego.length, 0.5 * scene.ego.width,
-                      0.5 * std::hypot(scene.ego.length, scene.ego.width), "ego"});
-    for (const Footprint& m : movers) {
+    const Footprint ego{e.center, e.yaw, 0.5 * scene.ego.length, 0.5 * scene.ego.width,
+                        0.5 * std::hypot(scene.ego.length, scene.ego.width), -1};
+    auto check = [&](const Footprint& m) {
       for (const Footprint& f : all) {
-        if (f.name == m.name || (m.c - f.c).norm() > m.radius + f.radius) continue;
+        if (f.index == m.index || (m.c - f.c).norm() > m.radius + f.radius) continue;
         const double depth = OverlapDepth(m, f);
         if (depth <= tolerance) continue;
-        auto key = std::minmax(m.name, f.name);
-        if (seen.insert(key).second) found.push_back({t, key.first, key.second, depth});
+        const auto key = std::minmax(m.index, f.index);
+        if (seen.insert(key).second) found.push_back({t, name(key.first), name(key.second), depth});
       }
-    }
+    };
+    for (int i : movers) check(all[i]);
+    check(ego);
   }
   return found;
 }

@@ -318,8 +318,9 @@ void LadarSimulator::GatherIntervals(const Scene& scene, int s, double azimuth,
 void LadarSimulator::FirstHit(double o_z, double slope, double* h_out, int* object) {
   double best = kInf;
   int who = kNothing;
+  const double ground = slope < 0.0 ? o_z / -slope : kInf;  // the ground plane z = 0
   if (slope < 0.0) {
-    best = o_z / -slope;  // the ground plane z = 0
+    best = ground;
     who = kGround;
   }
   const Interval* winner = nullptr;
@@ -342,7 +343,7 @@ void LadarSimulator::FirstHit(double o_z, double slope, double* h_out, int* obje
   }
   if (winner && winner->penetration > 0.0) {
     boost::random::exponential_distribution<double> depth(1.0 / winner->penetration);
-    best = std::min(best + depth(rng_), winner->h_out);
+    best = std::min({best + depth(rng_), winner->h_out, ground});  // not through the ground
   }
   *h_out = best;
   *object = who;

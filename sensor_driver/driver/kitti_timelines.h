@@ -1,0 +1,68 @@
+// The --kitti source of vtrack-ladar-driver and vtrack-ego-pose: a KITTI tracking sequence
+// (sensor_driver/kitti, vtrack::kitti::Sequence) laid out as a lap on the same wall-clock
+// schedule as a scenario (realtime.h). Lap time 0 is the sequence's first sweep start
+// (Sequence::ScanUtime(0)); a lap lasts num_frames * 100 ms; every utime of the sequence is moved
+// by the lap's start, so consecutive laps replay the sequence with time running on. Poses are
+// interpolated by Sequence::PoseAt at the requested rate over [0, lap); the last sweep's final
+// 100 ms / rate is left to the consumer's extrapolation.
+#pragma once
+
+#include <boost/program_options.hpp>
+#include <lcm/lcm-cpp.hpp>
+
+#include <memory>
+#include <string>
+
+#include "lcmtypes/util/process.h"
+#include "sensor_driver/driver/realtime.h"
+#include "sensor_driver/kitti/kitti_sequence.h"
+
+namespace vtrack::sim {
+
+// --kitti, --sequence, --poses, --oxts, --cache-dir as SequenceOptions.
+kitti::SequenceOptions KittiCliOptions(const boost::program_options::variables_map& vm);
+
+class KittiScanTimeline : public Timeline {
+ public:
+  // Throws kitti::KittiError for a missing or malformed sequence.
+  KittiScanTimeline(kitti::SequenceOptions options, lcm::LCM* lcm, std::string scan_channel,
+                    std::string truth_channel /* "" = no ground truth */);
+  int Count() const override { return seq_->num_frames(); }
+  std::int64_t PublishOffsetUs(int i) const override;
+  void Prepare(int i, std::int64_t lap_start_utime, std::int64_t lap) override;
+  void Publish() override;
+  std::int64_t LapUs() const;
+
+ private:
+  std::unique_ptr<kitti::Sequence> seq_;
+  lcm::LCM* lcm_;
+  std::string scan_channel_, truth_channel_;
+  std::int64_t base_;  // ScanUtime(0): lap time 0
+  vtrack::ladar_scan_t scan_;
+  vtrack::object_list_t truth_;
+  bool have_truth_ = false;
+  lcm_util::RateLimitedLog log_{"vtrack-ladar-driver"};
+};
+
+class KittiPoseTimeline : public Timeline {
+ public:
+  KittiPoseTimeline(kitti::SequenceOptions options, double rate_hz, lcm::LCM* lcm,
+                    std::string channel);
+  int Count() const override { return count_; }
+  std::int64_t PublishOffsetUs(int k) const override;
+  void Prepare(int k, std::int64_t lap_start_utime, std::int64_t lap) override;
+  void Publish() override;
+  std::int64_t LapUs() const;
+
+ private:
+  std::unique_ptr<kitti::Sequence> seq_;
+  double rate_hz_;
+  lcm::LCM* lcm_;
+  std::string channel_;
+  std::int64_t base_;
+  int count_ = 0;
+  vtrack::pose_t pose_;
+  lcm_util::RateLimitedLog log_{"vtrack-ego-pose"};
+};
+
+}  // namespace vtrack::sim

@@ -1,0 +1,104 @@
+// The --kitti source of vtrack-ladar-driver and vtrack-ego-pose, live on udpm:// in a private
+// network namespace: the logged scans, ground truth and poses are, byte for byte, the KITTI
+// reader's (sensor_driver/kitti) moved to the run's start time. Skips without the real data.
+#include <gtest/gtest.h>
+
+#include <signal.h>
+
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "lcmtypes/util/log_reader.h"
+#include "lcmtypes/util/process.h"
+#include "sensor_driver/kitti/kitti_sequence.h"
+#include "tests/support/subprocess.h"
+#include "tests/support/test_env.h"
+
+namespace vtrack {
+namespace {
+
+using namespace std::chrono_literals;
+using testing::BinDir;
+using testing::KittiDir;
+using testing::ReadFile;
+using testing::ScratchDir;
+using testing::Subprocess;
+
+constexpr char kUrl[] = "udpm://239.255.76.67:7667?ttl=0";
+constexpr char kLoggerUrl[] = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216";
+
+template <class T>
+std::string Encode(const T& m) {
+  std::string b(m.getEncodedSize(), '\0');
+  m.encode(b.data(), 0, static_cast<int>(b.size()));
+  return b;
+}
+
+TEST(KittiReplayTest, DriverAndEgoPosePublishTheSequenceOnTheRunClock) {
+  VTRACK_REQUIRE_PRIVATE_NETNS();
+  if (KittiDir().empty()) GTEST_SKIP() << "no KITTI data at " << testing::DataDir();
+  const std::string dir = ScratchDir("sim_kitti_replay");
+  // The point clouds are unpacked once per build tree (shared with the KITTI readers' tests);
+  // doing it here first lets the processes start on time.
+  const std::string cache = BinDir() + "/../kitti_cache";
+  kitti::SequenceOptions opt;
+  opt.dir = KittiDir();
+  opt.cache_dir = cache;
+  opt.sink = [](const std::string&) {};
+  const kitti::Sequence seq(opt);
+
+  const std::int64_t start = (lcm_util::WallUtime() / 1000 + 3000) * 1000;
+  const std::vector<std::string> common{"--kitti", KittiDir(), "--cache-dir", cache,
+                                        "--start-utime", std::to_string(start), "--laps", "1",
+                                        "--stop-after", "6.5", "--lcm-url", kUrl, "-q"};
+  const std::string log = dir + "/live.lcm";
+  {
+    Subprocess logger({"lcm-logger", "-q", "-f", std::string("--lcm-url=") + kLoggerUrl, log},
+                      dir + "/logger.txt");
+    std::vector<std::string> d{BinDir() + "/vtrack-ladar-driver"}, e{BinDir() + "/vtrack-ego-pose"};
+    d.insert(d.end(), common.begin(), common.end());
+    e.insert(e.end(), common.begin(), common.end());
+    Subprocess driver(d, dir + "/driver.txt");
+    Subprocess ego(e, dir + "/ego.txt");
+    const auto ds = driver.Wait(30000ms), es = ego.Wait(30000ms);
+    ASSERT_TRUE(ds && es);
+    EXPECT_EQ(*ds, 0) << ReadFile(dir + "/driver.txt");
+    EXPECT_EQ(*es, 0) << ReadFile(dir + "/ego.txt");
+    std::this_thread::sleep_for(700ms);
+    logger.Signal(SIGINT);
+    ASSERT_TRUE(logger.Wait(5000ms).has_value());
+  }
+  const std::int64_t shift = start - seq.ScanUtime(0);
+  int scans = 0, truths = 0, poses = 0;
+  lcm_util::LogReader r(log);
+  while (const lcm::LogEvent* ev = r.Next()) {
+    const std::string data(static_cast<const char*>(ev->data), static_cast<std::size_t>(ev->datalen));
+    if (ev->channel == "LADAR_SCAN") {
+      ladar_scan_t expected = seq.Scan(scans);
+      expected.utime += shift;
+      ASSERT_TRUE(Encode(expected) == data) << "scan " << scans;
+      ++scans;
+    } else if (ev->channel == "GROUND_TRUTH") {
+      object_list_t expected = seq.GroundTruth(truths);
+      expected.utime += shift;
+      ASSERT_TRUE(Encode(expected) == data) << "ground truth " << truths;
+      ++truths;
+    } else if (ev->channel == "EGO_POSE") {
+      const std::int64_t offset = poses * 10000LL;  // 100 Hz
+      pose_t expected = seq.PoseAt(seq.ScanUtime(0) + offset);
+      expected.utime = start + offset;
+      ASSERT_TRUE(Encode(expected) == data) << "pose " << poses;
+      ++poses;
+    }
+  }
+  // 3.5 s of the run were published: every frame (10 Hz) and pose (100 Hz) in that time.
+  EXPECT_GE(scans, 33);
+  EXPECT_EQ(truths, scans);
+  EXPECT_GE(poses, 340);
+}
+
+}  // namespace
+}  // namespace vtrack

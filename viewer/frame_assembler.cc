@@ -13,7 +13,8 @@ namespace {
 constexpr std::int64_t kJumpBackUs = 2'000'000;   // [us] a stream going back this far restarted
 constexpr std::int64_t kKeepExtraUs = 1'500'000;  // [us] messages kept beyond lag + scan_match
 constexpr std::int64_t kEgoTrailStepUs = 50'000;  // [us] ego path sampled at most at 20 Hz
-constexpr std::size_t kMaxScans = 512;            // bound on buffered scans whatever the times say
+constexpr std::size_t kMaxScans = 1024;           // bounds on buffered scans whatever the times
+constexpr std::int64_t kMaxScanPoints = 16'000'000; // say: ~350 MB of points at most
 constexpr std::size_t kMaxMessages = 4096;        // same for tracks / debug / truth messages
 
 std::int64_t Seconds(double s) { return static_cast<std::int64_t>(std::llround(s * 1e6)); }
@@ -84,6 +85,7 @@ void FrameAssembler::Reset() {
   last_emitted_ = -1;
   has_origin_ = false;
   scans_.clear();
+  scan_points_ = 0;
   tracks_.clear();
   debug_.clear();
   truth_.clear();
@@ -123,6 +125,7 @@ void FrameAssembler::AddScan(std::shared_ptr<const vtrack::ladar_scan_t> scan) {
   if (!scan) return;
   CheckJumpBack(scan->utime, &last_scan_utime_);
   Advance(scan->utime);
+  scan_points_ += scan->npoints;
   scans_.push_back(scan);
   const bool tracks_quiet =
       last_tracks_clock_ < 0 || clock_ - last_tracks_clock_ > params_.auto_idle_us;
@@ -185,7 +188,9 @@ void FrameAssembler::Prune() {
   const std::int64_t keep_from =
       std::min(clock_ - params_.lag_us - params_.scan_match_us - kKeepExtraUs,
                oldest_needed - params_.scan_match_us);
-  while (!scans_.empty() && (scans_.front()->utime < keep_from || scans_.size() > kMaxScans)) {
+  while (!scans_.empty() && (scans_.front()->utime < keep_from || scans_.size() > kMaxScans ||
+                              scan_points_ > kMaxScanPoints)) {
+    scan_points_ -= scans_.front()->npoints;
     scans_.pop_front();
   }
   EraseBefore(&tracks_, keep_from, kMaxMessages);

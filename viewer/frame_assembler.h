@@ -134,6 +134,7 @@ class FrameAssembler {
   std::vector<FrameInputs> ready_;  // handed out by the next TakeReady (after a reset)
 
   std::deque<std::shared_ptr<const vtrack::ladar_scan_t>> scans_;  // arrival order
+  std::int64_t scan_points_ = 0;                                     // points in scans_
   std::map<std::int64_t, std::shared_ptr<const vtrack::track_list_t>> tracks_;
   std::map<std::int64_t, std::shared_ptr<const vtrack::track_debug_t>> debug_;
   std::map<std::int64_t, std::shared_ptr<const vtrack::object_list_t>> truth_;

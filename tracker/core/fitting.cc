@@ -89,8 +89,11 @@ struct EndOffset {
 
 // The data and noise model of one fit.
 struct Context {
-  const float* x = nullptr;
-  const float* y = nullptr;
+  // Per point, precomputed once per fit: local position and unit ray from the sensor.
+  const double* px = nullptr;
+  const double* py = nullptr;
+  const double* rx = nullptr;
+  const double* ry = nullptr;
   int n = 0;
   Eigen::Vector2d origin = Eigen::Vector2d::Zero();  // world position of the local frame
   Eigen::Vector2d sensor = Eigen::Vector2d::Zero();  // local
@@ -99,9 +102,8 @@ struct Context {
   double k2 = 0.0;        // inlier_sigmas^2
   double min_t2 = 0.0;    // squared threshold floor
 
-  Eigen::Vector2d P(int i) const {
-    return {static_cast<double>(x[i]) - origin.x(), static_cast<double>(y[i]) - origin.y()};
-  }
+  Eigen::Vector2d P(int i) const { return {px[i], py[i]}; }
+  Eigen::Vector2d RayAt(int i) const { return {rx[i], ry[i]}; }
   Eigen::Vector2d Ray(const Eigen::Vector2d& p) const {
     const Eigen::Vector2d d = p - sensor;
     const double len = d.norm();
@@ -117,9 +119,10 @@ struct Context {
 // Normalised squared residual of a point (local p, unit ray) against edge k of the model, or
 // +inf if the point is not eligible for that edge (behind a corner by more than the threshold).
 // *r receives the signed distance and *var its variance.
-double EdgeError(const Context& ctx, const Model& m, int k, const Eigen::Vector2d& p,
+// u0, u1: the model's m.U0(), m.U1() (passed in: computed once per model, not per point).
+double EdgeError(const Context& ctx, const Model& m, const Eigen::Vector2d& u0,
+                 const Eigen::Vector2d& u1, int k, const Eigen::Vector2d& p,
                  const Eigen::Vector2d& ray, double* r, double* var) {
-  const Eigen::Vector2d u0 = m.U0(), u1 = m.U1();
   const Eigen::Vector2d v = p - m.c;
   const Eigen::Vector2d& normal = (k == 0) ? u1 : u0;
   const Eigen::Vector2d& along = (k == 0) ? u0 : u1;
@@ -153,6 +156,7 @@ std::uint64_t Classify(const Context& ctx, const Model& m, const std::int8_t* ma
   counts[0] = counts[1] = 0;
   std::uint64_t checksum = 0;
   double r, var;
+  const Eigen::Vector2d u0 = m.U0(), u1 = m.U1();
   for (int i = 0; i < ctx.n; ++i) {
     if (mask && mask[i] == kMaskExcluded) {
       labels[i] = FitResult::kOutlier;
@@ -160,12 +164,12 @@ std::uint64_t Classify(const Context& ctx, const Model& m, const std::int8_t* ma
       continue;
     }
     const Eigen::Vector2d p = ctx.P(i);
-    const Eigen::Vector2d ray = ctx.Ray(p);
+    const Eigen::Vector2d ray = ctx.RayAt(i);
     double best = 1.0;
     int within = 0;
     std::int8_t label = FitResult::kOutlier;
     for (int k = 0; k < m.num_edges; ++k) {
-      const double e = EdgeError(ctx, m, k, p, ray, &r, &var);
+      const double e = EdgeError(ctx, m, u0, u1, k, p, ray, &r, &var);
       within += e < 1.0;
       if (e < best) {
         best = e;
@@ -338,7 +342,7 @@ bool FindPerpendicularFaces(const Context& ctx, const Candidate& cand, const std
   for (int i = 0; i < ctx.n; ++i) {
     if (labels[i] != 0) continue;
     const Eigen::Vector2d p = ctx.P(i);
-    const double w = 1.0 / ctx.PerpVar(n_out.dot(ctx.Ray(p)));
+    const double w = 1.0 / ctx.PerpVar(n_out.dot(ctx.RayAt(i)));
     const double t = u.dot(p - m.c);
     sw += w;
     swt += w * t;
@@ -363,8 +367,8 @@ bool FindPerpendicularFaces(const Context& ctx, const Candidate& cand, const std
       const double depth = -n_out.dot(v);
       if (depth <= 0.0 || depth > max_depth) continue;
       // Clearly behind the edge, not one of its own points beyond an end.
-      if (depth * depth < ctx.Threshold2(ctx.PerpVar(n_out.dot(ctx.Ray(p))))) continue;
-      const double var = ctx.PerpVar(u.dot(ctx.Ray(p)));  // its face's normal is u
+      if (depth * depth < ctx.Threshold2(ctx.PerpVar(n_out.dot(ctx.RayAt(i))))) continue;
+      const double var = ctx.PerpVar(u.dot(ctx.RayAt(i)));  // its face's normal is u
       const double t = std::sqrt(ctx.Threshold2(var));
       const double off = outward.dot(v);
       if (off < -t || off > window + t) continue;
@@ -483,7 +487,7 @@ bool GaussNewtonStep(const Context& ctx, const std::int8_t* labels, Model* m,
     // d(normal)/d(phi): d(u1)/d(phi) = -u0, d(u0)/d(phi) = u1.
     const Eigen::Vector2d d_normal = (k == 0) ? Eigen::Vector2d(-u0) : u1;
     const double r = normal.dot(v);
-    const double w = 1.0 / ctx.PerpVar(normal.dot(ctx.Ray(p)));
+    const double w = 1.0 / ctx.PerpVar(normal.dot(ctx.RayAt(i)));
     const Eigen::Vector3d J(-normal.x(), -normal.y(), d_normal.dot(v));
     H.noalias() += w * J * J.transpose();
     g.noalias() += w * r * J;
@@ -785,7 +789,7 @@ FitFailure Measure(const Context& ctx, const FitRequest& req, const FitParams& p
     const Eigen::Vector2d p = ctx.P(i);
     const Eigen::Vector2d& normal = (k == 0) ? u1 : u0;
     const double r = normal.dot(p - m.c);
-    const double w = 1.0 / ctx.PerpVar(normal.dot(ctx.Ray(p)));
+    const double w = 1.0 / ctx.PerpVar(normal.dot(ctx.RayAt(i)));
     const Eigen::Vector3d J(-normal.x(), -normal.y(), Cross(normal, p - center));
     info.noalias() += w * J * J.transpose();
     chi2 += w * r * r;
@@ -877,11 +881,25 @@ void SegmentFitter::Fit(const FitRequest& req, FitResult* out) {
   }
 
   Context ctx;
-  ctx.x = req.x.data();
-  ctx.y = req.y.data();
   ctx.n = n;
   ctx.origin = Eigen::Vector2d(req.x[0], req.y[0]);
   ctx.sensor = req.sensor_xy - ctx.origin;
+  // Local coordinates and rays once per fit: every classification pass reuses them.
+  px_.resize(n);
+  py_.resize(n);
+  rx_.resize(n);
+  ry_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    px_[i] = static_cast<double>(req.x[i]) - ctx.origin.x();
+    py_[i] = static_cast<double>(req.y[i]) - ctx.origin.y();
+    const Eigen::Vector2d ray = ctx.Ray({px_[i], py_[i]});
+    rx_[i] = ray.x();
+    ry_[i] = ray.y();
+  }
+  ctx.px = px_.data();
+  ctx.py = py_.data();
+  ctx.rx = rx_.data();
+  ctx.ry = ry_.data();
   ctx.sigma2 = req.range_sigma_m * req.range_sigma_m;
   ctx.surface2 = P.surface_std_m * P.surface_std_m;
   ctx.k2 = P.inlier_sigmas * P.inlier_sigmas;
@@ -903,7 +921,7 @@ void SegmentFitter::Fit(const FitRequest& req, FitResult* out) {
     const int hi = static_cast<int>(static_cast<std::int64_t>(i + 1) * n / S) - 1;
     const int idx = hi > lo ? std::uniform_int_distribution<int>(lo, hi)(rng) : lo;
     const Eigen::Vector2d p = ctx.P(idx);
-    const Eigen::Vector2d ray = ctx.Ray(p);
+    const Eigen::Vector2d ray = ctx.RayAt(idx);
     sx_[i] = p.x();
     sy_[i] = p.y();
     srx_[i] = ray.x();

@@ -215,6 +215,7 @@ class SegmentFitter {
  private:
   FitParams params_;
   std::vector<double> sx_, sy_, srx_, sry_;  // scoring subset: local coordinates, ray directions
+  std::vector<double> px_, py_, rx_, ry_;    // all points: local coordinates, ray directions
   std::vector<double> proj_;                 // projections of one edge's inliers (sorting)
   std::vector<double> gaps_;                 // their spacings
   std::vector<std::int8_t> mask_;            // single edge: points marked ambiguous or excluded

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -347,6 +348,8 @@ void ExpectConsistent(const NeesRun& run) {
   for (double v : run.nees) mean += v;
   mean /= run.nees.size();
   const auto [lo, hi] = MeanChi2Bounds(static_cast<int>(run.nees.size()), 3);
+  std::printf("mean NEES %.3f over %zu fits, 95 %% bounds [%.3f, %.3f]\n", mean,
+              run.nees.size(), lo, hi);
   EXPECT_GE(mean, lo) << "R too large: mean NEES " << mean << " of " << run.nees.size();
   EXPECT_LE(mean, hi) << "R too small: mean NEES " << mean << " of " << run.nees.size();
   // Tails: the share above the chi-square(3) 99 % quantile stays near 1 %.
@@ -387,6 +390,7 @@ TEST(Fitting, OccludedSingleEdgeNeesNearChiSquare) {
   ASSERT_GE(run.nees.size(), 500u);
   double mean = 0.0;
   for (double v : run.nees) mean += v / run.nees.size();
+  std::printf("occluded single edge: mean NEES %.3f over %zu fits\n", mean, run.nees.size());
   EXPECT_GE(mean, MeanChi2Bounds(static_cast<int>(run.nees.size()), 3).first);
   EXPECT_LE(mean, 4.0);
 }

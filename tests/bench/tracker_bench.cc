@@ -1,115 +1,92 @@
-// The tracker's time per scan (Tracker::AddScan with the pose already there: preprocessing,
-// segmentation, association, fitting, filters, report), at steady state, on
-//  - a real KITTI HDL-64E frame sequence (../shared/data/kitti_tracking_0000; skipped with a
-//    message if absent): 98k-124k returns per scan;
-//  - the simulator's `stress` scenario (64-layer sensor, a large busy scene);
-//  - the single-plane paper_fig4_turn scenario.
-// Each iteration processes the next scan of the sequence; the tracker is rebuilt and warmed up
-// (untimed) when the sequence runs out. Run with --benchmark_repetitions=N for medians.
+// The whole tracker's time per scan (Tracker::AddScan with the scan's poses already in:
+// compensation, ground, segmentation, association, fitting, filters, hypotheses, report), at
+// steady state, one thread, measured as the thread's CPU time per scan (so other processes on
+// the machine do not inflate it; wall time is reported too):
+//  - BM_TrackerScan_Kitti: the real KITTI HDL-64E sequence 0000, frames 11-100 after 10 frames of
+//    warm-up (98k-124k returns per scan); skipped with a message if the data is absent;
+//  - BM_TrackerScan_Stress: the simulator's `stress` scenario (64 layers, ~300 vehicles);
+//  - BM_TrackerScan_Fig4: the single-plane paper_fig4_turn scenario.
+// Counters per benchmark: median_ms / p99_ms / wall_median_ms over the timed scans and, for the
+// 3-D sequences, the stage breakdown (median ms): pre_ms (compensation + ground), seg_ms,
+// assoc_ms (prediction + association) measured by running those stages alone on the same input
+// and tracker state just before the scan, and rest_ms = total - those (per-track fitting, EKF
+// updates, hypothesis management, new tracks, life cycle, report).
+//  - BM_CopyFloor_Kitti: the physical floor, a plain copy of each scan's point arrays (x, y, z,
+//    intensity, dt_us, ring) into buffers allocated once.
+//  - BM_PointsScaling/N: KITTI frames resampled to N = 10k..1M returns per scan (every k-th return
+//    below the native count; above it, each return repeated with a seeded 2 cm jitter: a denser
+//    sensor seeing the same scene).
+//  - BM_ObjectsScaling/N: a synthetic 3-D scene of N = 10..1000 cars (half of the rows moving)
+//    on a lattice around a stationary sensor, faces sampled at 0.2 deg of bearing on 7 rings,
+//    plus a fixed 29k-return ground; no occlusion.
+// The growth exponents are fitted by scripts/bench.sh (least squares in log-log).
+//
+//   build/bench/tracker_bench [--benchmark_filter=Kitti]
 #include <benchmark/benchmark.h>
 
-#include <filesystem>
+#include <time.h>
+
+#include <cmath>
+#include <cstring>
 #include <map>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
-#include "sensor_driver/kitti/kitti_sequence.h"
-#include "sensor_driver/sim/scenario.h"
-#include "sensor_driver/sim/simulator.h"
-#include "tracker/config.h"
-#include "tracker/core/tracker.h"
-#include "tracker/lcm_convert.h"
+#include "tests/bench/bench_data.h"
+#include "tracker/core/angle.h"
 
 namespace {
 
-namespace fs = std::filesystem;
 using namespace vtrack;
+using bench::Sequence;
 
-struct Sequence {
-  std::vector<LadarScan> scans;
-  std::vector<std::vector<EgoPose>> poses_before;  // poses to feed before scan i (through its end)
-  std::string error;
+double ThreadCpuSeconds() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+double WallSeconds() {
+  timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// The stages before the per-track updates, run alone on the tracker's state and the scan.
+struct StageProbe {
+  explicit StageProbe(const TrackerParams& p)
+      : params(p), pre(p.preprocess), seg(p.segmentation), assoc(p.association) {}
+  // Adds the CPU seconds of each stage to pre_s, seg_s, assoc_s.
+  void Run(const LadarScan& scan, const PoseHistory& poses, const TrackManager& manager) {
+    const double t0 = ThreadCpuSeconds();
+    const PreprocessResult r = pre.Run(scan, poses, 0, &points);
+    const double t1 = ThreadCpuSeconds();
+    seg.Run(points, scan.num_rings <= 1, r.sensor_xy, &segments);
+    const double t2 = ThreadCpuSeconds();
+    manager.Predict(scan.utime + scan.sweep_duration_us / 2, &predicted);
+    assoc.Run(predicted, points, segments, r.sensor_xy, &result);
+    const double t3 = ThreadCpuSeconds();
+    pre_s = t1 - t0;
+    seg_s = t2 - t1;
+    assoc_s = t3 - t2;
+  }
+  TrackerParams params;
+  Preprocessor pre;
+  Segmenter seg;
+  Associator assoc;
+  WorldPoints points;
+  Segments segments;
+  std::vector<PredictedObject> predicted;
+  AssociationResult result;
+  double pre_s = 0, seg_s = 0, assoc_s = 0;
 };
 
-TrackerParams Params() {
-  const std::string path = VTRACK_SOURCE_DIR "/config/tracker.yaml";
-  return fs::exists(path) ? LoadTrackerParams(path) : TrackerParams{};
-}
-
-// Poses up to each scan's end, from a pose function sampled every pose_dt_us.
-template <class PoseAt>
-void AddPoses(Sequence* s, std::int64_t first, std::int64_t pose_dt_us, PoseAt pose_at) {
-  std::int64_t next = first;
-  for (const LadarScan& scan : s->scans) {
-    std::vector<EgoPose> v;
-    while (next <= scan.end_utime() + pose_dt_us) {
-      v.push_back(pose_at(next));
-      next += pose_dt_us;
-    }
-    s->poses_before.push_back(std::move(v));
-  }
-}
-
-const Sequence& Kitti() {
-  static const Sequence seq = [] {
-    Sequence s;
-    const char* d = std::getenv("VTRACK_DATA_DIR");
-    const std::string dir = (d && *d ? std::string(d) : std::string(VTRACK_SOURCE_DIR "/../shared/data")) +
-                            "/kitti_tracking_0000";
-    if (!fs::is_directory(dir)) {
-      s.error = "KITTI data absent (" + dir + ")";
-      return s;
-    }
-    kitti::SequenceOptions o;
-    o.dir = dir;
-    o.cache_dir = VTRACK_BINARY_DIR "/kitti_cache";
-    const kitti::Sequence k(o);
-    // Frames 1..40: the poses (interpolated at 100 Hz) start at frame 0's time, after the start
-    // of frame 0's sweep.
-    const int n = std::min(k.num_frames() - 1, 41);
-    for (int i = 1; i < n; ++i) s.scans.push_back(ScanFromLcm(k.Scan(i)));
-    AddPoses(&s, k.FrameUtime(0), 10000, [&](std::int64_t t) {
-      return PoseFromLcm(k.PoseAt(std::min(t, k.FrameUtime(n))));
-    });
-    return s;
-  }();
-  return seq;
-}
-
-const Sequence& Scenario(const std::string& name, int num_scans) {
-  static std::map<std::string, Sequence> cache;
-  auto it = cache.find(name);
-  if (it != cache.end()) return it->second;
-  Sequence s;
-  try {
-    sim::Simulator simu(sim::LoadScenario(sim::ResolveScenarioPath(name)));
-    const std::int64_t start = 1'700'000'000'000'000;
-    const int n = std::min(simu.NumScans(), num_scans);
-    for (int i = 0; i < n; ++i) {
-      ladar_scan_t msg;
-      object_list_t truth;
-      simu.MakeScan(i, start, i, &msg, &truth);
-      s.scans.push_back(ScanFromLcm(std::move(msg)));
-    }
-    int k = 0;
-    for (const LadarScan& scan : s.scans) {
-      std::vector<EgoPose> v;
-      while (k < simu.NumPoses() && start + simu.PoseOffsetUs(k) <= scan.end_utime() + 20000) {
-        pose_t p;
-        simu.MakePose(k++, start, &p);
-        v.push_back(PoseFromLcm(p));
-      }
-      s.poses_before.push_back(std::move(v));
-    }
-  } catch (const std::exception& e) {
-    s.error = e.what();
-  }
-  return cache.emplace(name, std::move(s)).first->second;
-}
-
-// Times Tracker::AddScan of each scan after a warm-up of `warmup` scans.
-void RunSequence(benchmark::State& state, const Sequence& seq, int warmup) {
+// Times Tracker::AddScan of each scan after a warm-up of `warmup` scans; one iteration per scan
+// (the tracker is rebuilt and warmed up, untimed, when the sequence runs out).
+void RunSequence(benchmark::State& state, const Sequence& seq, int warmup, bool breakdown,
+                 const TrackerParams& params = bench::ShippedParams()) {
   if (!seq.error.empty()) {
     state.SkipWithError(seq.error.c_str());
     return;
@@ -118,13 +95,15 @@ void RunSequence(benchmark::State& state, const Sequence& seq, int warmup) {
     state.SkipWithError("sequence too short");
     return;
   }
-  const TrackerParams params = Params();
   std::unique_ptr<Tracker> tracker;
+  std::unique_ptr<StageProbe> probe;
+  if (breakdown) probe = std::make_unique<StageProbe>(params);
+  const PoseHistory all_poses = bench::AllPoses(seq);
   std::size_t i = seq.scans.size();
   std::vector<ScanOutput> out;
-  std::int64_t points = 0, tracks = 0;
+  std::vector<double> cpu_ms, wall_ms, pre_ms, seg_ms, assoc_ms, rest_ms;
+  double points = 0, tracks = 0;
   for (auto _ : state) {
-    state.PauseTiming();
     if (i >= seq.scans.size()) {
       tracker = std::make_unique<Tracker>(params);
       for (i = 0; i < static_cast<std::size_t>(warmup); ++i) {
@@ -134,28 +113,233 @@ void RunSequence(benchmark::State& state, const Sequence& seq, int warmup) {
       }
     }
     for (const auto& p : seq.poses_before[i]) tracker->AddPose(p, &out);
+    if (probe) probe->Run(seq.scans[i], all_poses, tracker->manager());
     LadarScan copy = seq.scans[i];
-    points += static_cast<std::int64_t>(copy.size());
+    points += static_cast<double>(copy.size());
     out.clear();
-    state.ResumeTiming();
+    const double w0 = WallSeconds(), c0 = ThreadCpuSeconds();
     tracker->AddScan(std::move(copy), &out);  // processed here: its poses are in
-    state.PauseTiming();
-    if (out.size() != 1) state.SkipWithError("scan was not processed");
-    if (!out.empty()) tracks += static_cast<std::int64_t>(out.back().tracks.size());
+    const double c1 = ThreadCpuSeconds(), w1 = WallSeconds();
+    state.SetIterationTime(c1 - c0);
+    if (out.size() != 1) {
+      state.SkipWithError("scan was not processed");
+      return;
+    }
+    tracks += static_cast<double>(out.back().tracks.size());
+    cpu_ms.push_back(1e3 * (c1 - c0));
+    wall_ms.push_back(1e3 * (w1 - w0));
+    if (probe) {
+      pre_ms.push_back(1e3 * probe->pre_s);
+      seg_ms.push_back(1e3 * probe->seg_s);
+      assoc_ms.push_back(1e3 * probe->assoc_s);
+      rest_ms.push_back(cpu_ms.back() - pre_ms.back() - seg_ms.back() - assoc_ms.back());
+    }
     ++i;
-    state.ResumeTiming();
   }
-  state.counters["points/scan"] = benchmark::Counter(static_cast<double>(points), benchmark::Counter::kAvgIterations);
-  state.counters["tracks/scan"] = benchmark::Counter(static_cast<double>(tracks), benchmark::Counter::kAvgIterations);
+  const double n = static_cast<double>(cpu_ms.size());
+  state.counters["points_per_scan"] = points / n;
+  state.counters["tracks_per_scan"] = tracks / n;
+  state.counters["median_ms"] = bench::Percentile(cpu_ms, 50);
+  state.counters["p99_ms"] = bench::Percentile(cpu_ms, 99);
+  state.counters["max_ms"] = bench::Percentile(cpu_ms, 100);
+  state.counters["wall_median_ms"] = bench::Percentile(wall_ms, 50);
+  state.counters["wall_p99_ms"] = bench::Percentile(wall_ms, 99);
+  if (probe) {
+    state.counters["pre_ms"] = bench::Percentile(pre_ms, 50);
+    state.counters["seg_ms"] = bench::Percentile(seg_ms, 50);
+    state.counters["assoc_ms"] = bench::Percentile(assoc_ms, 50);
+    state.counters["rest_ms"] = bench::Percentile(rest_ms, 50);
+  }
 }
 
-void BM_TrackerScan_Kitti(benchmark::State& state) { RunSequence(state, Kitti(), 10); }
-void BM_TrackerScan_Stress(benchmark::State& state) { RunSequence(state, Scenario("stress", 40), 10); }
-void BM_TrackerScan_Fig4(benchmark::State& state) { RunSequence(state, Scenario("paper_fig4_turn", 200), 50); }
+const Sequence& StressSeq() { return bench::Scenario("stress", 100); }
 
-BENCHMARK(BM_TrackerScan_Kitti)->Unit(benchmark::kMillisecond)->Iterations(30);
-BENCHMARK(BM_TrackerScan_Stress)->Unit(benchmark::kMillisecond)->Iterations(30);
-BENCHMARK(BM_TrackerScan_Fig4)->Unit(benchmark::kMicrosecond)->Iterations(150);
+void BM_TrackerScan_Kitti(benchmark::State& state) { RunSequence(state, bench::Kitti(), 10, true); }
+void BM_TrackerScan_Stress(benchmark::State& state) { RunSequence(state, StressSeq(), 10, true); }
+void BM_TrackerScan_Fig4(benchmark::State& state) {
+  RunSequence(state, bench::Scenario("paper_fig4_turn", 200), 50, false);
+}
+
+BENCHMARK(BM_TrackerScan_Kitti)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(90);
+BENCHMARK(BM_TrackerScan_Stress)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(90);
+BENCHMARK(BM_TrackerScan_Fig4)->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(150);
+
+// A plain copy of every point array of each scan, into buffers allocated once.
+void BM_CopyFloor_Kitti(benchmark::State& state) {
+  const Sequence& seq = bench::Kitti();
+  if (!seq.error.empty()) {
+    state.SkipWithError(seq.error.c_str());
+    return;
+  }
+  LadarScan dst;
+  auto copy_into = [](const auto& src, auto* d) {
+    d->resize(src.size());
+    std::memcpy(d->data(), src.data(), src.size() * sizeof(src[0]));
+  };
+  std::size_t i = 0;
+  std::vector<double> ms;
+  double bytes = 0;
+  for (auto _ : state) {
+    const LadarScan& s = seq.scans[i];
+    const double c0 = ThreadCpuSeconds();
+    copy_into(s.x, &dst.x);
+    copy_into(s.y, &dst.y);
+    copy_into(s.z, &dst.z);
+    copy_into(s.intensity, &dst.intensity);
+    copy_into(s.dt_us, &dst.dt_us);
+    copy_into(s.ring, &dst.ring);
+    benchmark::ClobberMemory();
+    const double c1 = ThreadCpuSeconds();
+    state.SetIterationTime(c1 - c0);
+    ms.push_back(1e3 * (c1 - c0));
+    bytes += static_cast<double>(s.size() * (4 * sizeof(float) + sizeof(std::int32_t) + sizeof(std::int16_t)));
+    i = (i + 1) % seq.scans.size();
+  }
+  state.counters["median_ms"] = bench::Percentile(ms, 50);
+  state.SetBytesProcessed(static_cast<std::int64_t>(bytes));
+}
+BENCHMARK(BM_CopyFloor_Kitti)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(400);
+
+// KITTI frames 1..20 resampled to n returns per scan (one size cached at a time).
+const Sequence& Resampled(std::size_t n) {
+  static std::size_t cached_n = 0;
+  static Sequence s;
+  if (cached_n == n) return s;
+  const Sequence& k = bench::Kitti();
+  s = Sequence{};
+  s.name = "kitti_resampled";
+  cached_n = n;
+  if (!k.error.empty()) {
+    s.error = k.error;
+    return s;
+  }
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> jitter(-0.02f, 0.02f);
+  const std::size_t num = std::min<std::size_t>(20, k.scans.size());
+  for (std::size_t f = 0; f < num; ++f) {
+    const LadarScan& src = k.scans[f];
+    LadarScan dst = src;
+    dst.x.clear(), dst.y.clear(), dst.z.clear(), dst.intensity.clear(), dst.dt_us.clear(), dst.ring.clear();
+    const std::size_t m = src.size();
+    for (std::size_t j = 0; j < n; ++j) {
+      // Below the native count: every k-th return; above: return j % m (jittered repeats).
+      const std::size_t i = n <= m ? j * m / n : j % m;
+      const float e = (n > m && j >= m) ? 1.0f : 0.0f;
+      dst.x.push_back(src.x[i] + e * jitter(rng));
+      dst.y.push_back(src.y[i] + e * jitter(rng));
+      dst.z.push_back(src.z[i] + e * jitter(rng));
+      dst.intensity.push_back(src.intensity[i]);
+      dst.dt_us.push_back(src.dt_us[i]);
+      dst.ring.push_back(src.ring[i]);
+    }
+    s.scans.push_back(std::move(dst));
+    s.poses_before.push_back(k.poses_before[f]);
+  }
+  return s;
+}
+
+void BM_PointsScaling(benchmark::State& state) {
+  TrackerParams p = bench::ShippedParams();
+  p.preprocess.max_points = 2'000'000;
+  RunSequence(state, Resampled(static_cast<std::size_t>(state.range(0))), 5, true, p);
+}
+BENCHMARK(BM_PointsScaling)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(15)
+    ->Arg(10'000)
+    ->Arg(30'000)
+    ->Arg(100'000)
+    ->Arg(300'000)
+    ->Arg(1'000'000);
+
+// n cars on a 6 m x 3 m lattice around a stationary sensor (nearest lattice nodes beyond 5 m),
+// every other row driving along +x at 3 m/s; 30 scans at 10 Hz.
+const Sequence& Cars(int n) {
+  static std::map<int, Sequence> cache;
+  auto it = cache.find(n);
+  if (it != cache.end()) return it->second;
+  Sequence s;
+  s.name = "cars";
+  struct Car {
+    double x, y, v;
+  };
+  std::vector<Car> cars;
+  for (int r = -30; r <= 30; ++r) {
+    for (int c = -15; c <= 15; ++c) {
+      const double x = 6.0 * c + (r % 2 ? 3.0 : 0.0), y = 3.0 * r;
+      if (std::hypot(x, y) < 5.0) continue;
+      cars.push_back({x, y, (r % 2) ? 3.0 : 0.0});
+    }
+  }
+  std::sort(cars.begin(), cars.end(), [](const Car& a, const Car& b) {
+    return std::hypot(a.x, a.y) < std::hypot(b.x, b.y);
+  });
+  cars.resize(std::min<std::size_t>(cars.size(), static_cast<std::size_t>(n)));
+  const double kMount = 1.73, kLength = 4.5, kWidth = 1.8, kBeam = DegToRad(0.2);
+  const std::int64_t t0 = 1'700'000'000'000'000, sweep = 100'000;
+  for (int k = 0; k < 30; ++k) {
+    LadarScan scan;
+    scan.utime = t0 + k * sweep;
+    scan.seq = k;
+    scan.sweep_duration_us = sweep;
+    scan.max_range = 120.0f;
+    scan.num_rings = 64;
+    scan.body_from_sensor.translation() = Eigen::Vector3d(0, 0, kMount);
+    auto add = [&](double x, double y, double z, int ring) {
+      scan.x.push_back(static_cast<float>(x));
+      scan.y.push_back(static_cast<float>(y));
+      scan.z.push_back(static_cast<float>(z - kMount));
+      scan.intensity.push_back(0.5f);
+      const double az = std::atan2(y, x) + M_PI;  // [0, 2 pi]
+      scan.dt_us.push_back(static_cast<std::int32_t>(std::min<double>(sweep, az / (2 * M_PI) * sweep)));
+      scan.ring.push_back(static_cast<std::int16_t>(ring));
+    };
+    // Ground: 16 range rings x 1800 bearings.
+    for (int r = 0; r < 16; ++r) {
+      const double range = 4.0 + 2.4 * r;
+      for (int b = 0; b < 1800; ++b) {
+        const double a = 2 * M_PI * b / 1800;
+        add(range * std::cos(a), range * std::sin(a), 0.0, 63 - r);
+      }
+    }
+    for (const Car& car : cars) {
+      const double cx = car.x + car.v * 0.1 * k, cy = car.y;
+      const std::array<Eigen::Vector2d, 4> corner = {Eigen::Vector2d(cx + kLength / 2, cy + kWidth / 2),
+                                                     Eigen::Vector2d(cx - kLength / 2, cy + kWidth / 2),
+                                                     Eigen::Vector2d(cx - kLength / 2, cy - kWidth / 2),
+                                                     Eigen::Vector2d(cx + kLength / 2, cy - kWidth / 2)};
+      for (int f = 0; f < 4; ++f) {
+        const Eigen::Vector2d a = corner[static_cast<std::size_t>(f)], b = corner[static_cast<std::size_t>((f + 1) % 4)];
+        const Eigen::Vector2d mid = 0.5 * (a + b), normal = (mid - Eigen::Vector2d(cx, cy)).normalized();
+        if (normal.dot(-mid) <= 0.0) continue;  // faces away from the sensor
+        const double span = std::abs(std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b)));
+        const int samples = std::max(2, static_cast<int>(span / kBeam));
+        for (int q = 0; q <= samples; ++q) {
+          const Eigen::Vector2d p = a + (b - a) * (static_cast<double>(q) / samples);
+          for (int ring = 0; ring < 7; ++ring) add(p.x(), p.y(), 0.3 + 0.2 * ring, 20 + ring);
+        }
+      }
+    }
+    s.scans.push_back(std::move(scan));
+  }
+  bench::AddPoses(&s, t0 - 20'000, 10'000, [](std::int64_t t) { return EgoPose{t, Eigen::Isometry3d::Identity()}; });
+  return cache.emplace(n, std::move(s)).first->second;
+}
+
+void BM_ObjectsScaling(benchmark::State& state) {
+  RunSequence(state, Cars(static_cast<int>(state.range(0))), 10, true);
+  state.counters["objects"] = static_cast<double>(state.range(0));
+}
+BENCHMARK(BM_ObjectsScaling)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(20)
+    ->Arg(10)
+    ->Arg(30)
+    ->Arg(100)
+    ->Arg(300)
+    ->Arg(1000);
 
 }  // namespace
 

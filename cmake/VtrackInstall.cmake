@@ -30,3 +30,24 @@ write_basic_package_version_file(${CMAKE_CURRENT_BINARY_DIR}/vtrackConfigVersion
 install(FILES ${CMAKE_CURRENT_BINARY_DIR}/vtrackConfig.cmake
   ${CMAKE_CURRENT_BINARY_DIR}/vtrackConfigVersion.cmake
   DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/vtrack)
+
+# systemd unit templates and their environment file (deploy/, issue 8): share/vtrack/systemd.
+# The units are configured at install time, so that their paths follow the prefix actually used
+# (`cmake --install build --prefix P`); component `systemd` installs them alone.
+find_program(LCM_LOGGER_EXECUTABLE lcm-logger)
+if(NOT LCM_LOGGER_EXECUTABLE)
+  set(LCM_LOGGER_EXECUTABLE /usr/bin/lcm-logger)
+endif()
+file(GLOB VTRACK_UNIT_TEMPLATES ${PROJECT_SOURCE_DIR}/deploy/systemd/*.service.in)
+install(CODE "
+  set(VTRACK_UNIT_BINDIR \"\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_BINDIR}\")
+  set(VTRACK_UNIT_DATADIR \"\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_DATADIR}/vtrack\")
+  set(LCM_LOGGER_EXECUTABLE \"${LCM_LOGGER_EXECUTABLE}\")
+  foreach(in ${VTRACK_UNIT_TEMPLATES})
+    get_filename_component(unit \"\${in}\" NAME_WLE)
+    configure_file(\"\${in}\" \"${CMAKE_CURRENT_BINARY_DIR}/systemd/\${unit}\" @ONLY)
+    file(INSTALL DESTINATION \"\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_DATADIR}/vtrack/systemd\"
+      TYPE FILE FILES \"${CMAKE_CURRENT_BINARY_DIR}/systemd/\${unit}\")
+  endforeach()" COMPONENT systemd)
+install(FILES ${PROJECT_SOURCE_DIR}/deploy/vtrack.env ${PROJECT_SOURCE_DIR}/deploy/README.md
+  DESTINATION ${CMAKE_INSTALL_DATADIR}/vtrack/systemd COMPONENT systemd)

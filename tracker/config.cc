@@ -169,6 +169,7 @@ void Read(const YAML::Node& root, const std::string& origin, TrackerParams* p) {
     s.Get("outside_penalty", &q.outside_penalty);
     s.Get("miss_cost", &q.miss_cost);
     s.Get("merge_fraction", &q.merge_fraction);
+    s.Get("ignore_max_extent", &q.ignore_max_extent);
     s.Get("split_min_points", &q.split_min_points);
     s.Get("min_slant_deg", &q.min_slant_deg);
     s.Done();
@@ -255,6 +256,8 @@ void Read(const YAML::Node& root, const std::string& origin, TrackerParams* p) {
     s.Get("duplicate_overlap", &q.duplicate_overlap);
     s.Get("range_sigma", &q.range_sigma);
     s.Get("fit_contour_deg", &q.fit_contour_deg);
+    s.Get("contour_support_height", &q.contour_support_height);
+    s.Get("contour_support_range", &q.contour_support_range);
     s.Get("default_length", &q.default_length);
     s.Get("default_width", &q.default_width);
     s.Get("default_dimension_std", &q.default_dimension_std);

@@ -167,13 +167,28 @@ TEST(TrackerLiveTest, UrbanIntersectionLiveWith64LayerScans) {
               st.median_latency_ms);
   EXPECT_GE(st.scans_processed, 110);  // of 120: the large socket buffer keeps (nearly) all
   EXPECT_GT(r.due, 500);
-  // Open (tracker/README.md): on this scene not every vehicle is tracked yet; the live run must
-  // do as well as the offline run of the same lap.
-  const EvalResult off = EvaluateTracks(run.sim_log, run.offline);
-  std::printf("offline urban_intersection (12 s): %s\n", Summary(off).c_str());
-  EXPECT_GE(r.matched, off.matched * 95 / 100);
+  for (const auto& m : r.misses) std::printf("  %s\n", m.c_str());
+  for (const auto& [vehicle, ids] : r.ids) {
+    if (ids.size() < 2) continue;
+    std::printf("  vehicle %lld: tracks", static_cast<long long>(vehicle));
+    for (const auto id : ids) std::printf(" %lld", static_cast<long long>(id));
+    std::printf("\n");
+  }
+  // Issue 5 asks for every due vehicle tracked and no identity switch. Not met yet on this scene
+  // (tracker/README.md, open issues: 97.0% of due (vehicle, scan) pairs on this lap, 29 identity
+  // switches, on parked rows seen at a grazing angle). Asserted: about what it achieves, so
+  // that a regression fails, with the misses and switches printed above.
+  EXPECT_GE(r.matched * 100, r.due * 96) << (r.misses.empty() ? "" : r.misses.front());
+  EXPECT_LE(r.id_switches, 35);
   EXPECT_EQ(r.max_hyps_not_moving, 1);
   EXPECT_LE(r.max_hyps_moving, 4);
+  EXPECT_EQ(r.max_hyps_stationary_truth, 1);  // no parked car is judged a mover
+  // Live and offline: the same tracks when nothing is lost on the bus.
+  const EvalResult off = EvaluateTracks(run.sim_log, run.offline);
+  std::printf("offline urban_intersection (12 s): %s\n", Summary(off).c_str());
+  if (st.scans_processed == LastStatus(run.offline).scans_processed) {
+    EXPECT_GT(CompareTracks(TracksByUtime(run.live_log), TracksByUtime(run.offline), 1e-9), 100);
+  }
   std::filesystem::remove(run.sim_log);
   std::filesystem::remove(run.live_log);
 }

@@ -47,6 +47,11 @@ TEST(TrackerConfigTest, ShippedFileLoadsAndStatesTheDefaults) {
   EXPECT_EQ(p.input.max_pose_wait_us, d.input.max_pose_wait_us);
   EXPECT_EQ(p.fit.max_scoring_points, d.fit.max_scoring_points);
   EXPECT_EQ(p.vasm.epsilon_L, d.vasm.epsilon_L);
+  EXPECT_EQ(p.vasm.initial_L, d.vasm.initial_L);
+  EXPECT_EQ(p.vasm.initial_L_std, d.vasm.initial_L_std);
+  EXPECT_EQ(p.fit.max_inlier_gap_m, d.fit.max_inlier_gap_m);
+  EXPECT_EQ(p.manager.contour_support_height, d.manager.contour_support_height);
+  EXPECT_EQ(p.manager.contour_support_range, d.manager.contour_support_range);
   EXPECT_EQ(p.ism.alpha, d.ism.alpha);
   EXPECT_EQ(p.ekf.gate_probability, d.ekf.gate_probability);
   EXPECT_EQ(p.shape.half_life, d.shape.half_life);

@@ -17,10 +17,14 @@
 //  - split: a segment that is a candidate of two or more established tracks (two parked cars
 //    merged by the grid) is split between them, each return going to the rectangle it is
 //    nearest to, before the assignment;
-//  - merge: an unassigned segment with at least merge_fraction of its returns inside the gate
-//    of an assigned track joins that track (an object cut in two by an occluder);
-//  - a leftover that is a candidate of some track but not merged is ignored (it would
-//    otherwise seed a duplicate of that track);
+//  - merge: an unassigned segment with at least merge_fraction of its returns inside the
+//    predicted rectangle of an assigned track grown by gate_margin only (not by the position
+//    uncertainty), which does not stretch the track's returns beyond the dimensions seen so far
+//    (PredictedObject::seen_*) by more than gate_margin, joins that track (an object cut in two
+//    by an occluder);
+//  - a leftover with at least min_inside_fraction of its returns on the rectangle of some track
+//    grown by gate_margin, or smaller than ignore_max_extent and inside some track's gate, but
+//    not merged, is ignored (it would otherwise seed a duplicate of that track);
 //  - what remains unassigned seeds new tracks.
 #pragma once
 
@@ -44,6 +48,7 @@ struct AssociationParams {
   double outside_penalty = 2.0;      // [m] cost per unit fraction of returns outside the gate
   double miss_cost = 3.0;            // [m] cost of leaving a track unassigned
   double merge_fraction = 0.6;       // [-] leftover segment joins an assigned track above this
+  double ignore_max_extent = 1.0;    // [m] smaller leftovers inside a gate are ignored
   int split_min_points = 3;          // [-] each part of a split segment has at least this many
   double min_slant_deg = 10.0;       // [deg] s in Eq. 15
 
@@ -57,6 +62,11 @@ struct PredictedObject {
   OrientedBox box;                   // predicted rectangle at the scan time
   double position_std = 0.0;         // [m] sqrt of the largest eigenvalue of the xy covariance
   bool established = false;          // confirmed or coasting (may claim part of a split segment)
+  // Dimensions seen so far (shape estimates; box holds at least a default vehicle's): a leftover
+  // piece merges into the track only if the merged returns stay within these + gate_margin.
+  // 0: unknown (the box bounds them).
+  double seen_length = 0.0;          // [m]
+  double seen_width = 0.0;           // [m]
 };
 
 struct AssociationResult {
@@ -69,7 +79,7 @@ struct AssociationResult {
   std::vector<std::vector<std::int32_t>> new_objects;
   std::int32_t num_split = 0;   // segments split between tracks
   std::int32_t num_merged = 0;  // leftover segments merged into a track
-  std::int32_t num_ignored = 0; // leftover segments inside a track's gate but not merged
+  std::int32_t num_ignored = 0; // leftover segments on a track's rectangle but not merged
 };
 
 // Solves min sum cost[r][assign[r]] over one-to-one assignments of rows to columns

@@ -52,6 +52,42 @@ double Overlap(const OrientedBox& a, const OrientedBox& b) {
 
 }  // namespace
 
+void RangeProfile::Build(const Eigen::Vector2d& sensor_xy, const std::vector<double>& x,
+                         const std::vector<double>& y, double bin_deg) {
+  sensor_ = sensor_xy;
+  const int n = std::max(1, static_cast<int>(std::ceil(360.0 / bin_deg)));
+  inv_bin_ = n / (2.0 * kPi);
+  nearest_.assign(static_cast<std::size_t>(n), std::numeric_limits<float>::infinity());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const Eigen::Vector2d p(x[i], y[i]);
+    float& r = nearest_[static_cast<std::size_t>(Bin(p))];
+    r = std::min(r, static_cast<float>((p - sensor_).norm()));
+  }
+}
+
+int RangeProfile::Bin(const Eigen::Vector2d& p) const {
+  const Eigen::Vector2d d = p - sensor_;
+  const int n = static_cast<int>(nearest_.size());
+  const int b = static_cast<int>(std::floor((std::atan2(d.y(), d.x()) + kPi) * inv_bin_));
+  return ((b % n) + n) % n;
+}
+
+bool RangeProfile::FreeBeyond(const Eigen::Vector2d& end, const Eigen::Vector2d& inner,
+                              double margin, int bins) const {
+  if (nearest_.empty()) return false;
+  const Eigen::Vector2d de = end - sensor_, di = inner - sensor_;
+  // Beyond = the rotation sense from inner to end.
+  const int step = de.x() * di.y() - de.y() * di.x() < 0.0 ? 1 : -1;
+  const int n = static_cast<int>(nearest_.size());
+  const double r = de.norm();
+  const int b0 = Bin(end);
+  for (int k = 1; k <= bins; ++k) {
+    const int b = (((b0 + step * k) % n) + n) % n;
+    if (nearest_[static_cast<std::size_t>(b)] < r + margin) return false;
+  }
+  return true;
+}
+
 const char* ToString(TrackerMode mode) {
   switch (mode) {
     case TrackerMode::kMht: return "mht";
@@ -99,6 +135,10 @@ bool TrackManagerParams::Validate(std::string* error) const {
              "> 0", error) ||
       !Check(p.fit_contour_deg >= 0 && p.fit_contour_deg <= 10, "fit_contour_deg",
              p.fit_contour_deg, "deg", "in [0, 10]", error) ||
+      !Check(p.contour_support_height >= 0 && p.contour_support_height <= 2,
+             "contour_support_height", p.contour_support_height, "m", "in [0, 2]", error) ||
+      !Check(p.contour_support_range > 0 && p.contour_support_range <= 2, "contour_support_range",
+             p.contour_support_range, "m", "in (0, 2]", error) ||
       !Check(p.default_length > 0 && p.default_length <= 30, "default_length", p.default_length,
              "m", "in (0, 30]", error) ||
       !Check(p.default_width > 0 && p.default_width <= 10, "default_width", p.default_width, "m",
@@ -192,6 +232,9 @@ void TrackManager::Predict(std::int64_t utime, std::vector<PredictedObject>* out
     const double a = h.P(idx[0], idx[0]), b = h.P(idx[0], idx[1]), c = h.P(idx[1], idx[1]);
     p.position_std = std::sqrt(std::max(0.0, 0.5 * (a + c) + std::hypot(0.5 * (a - c), b)));
     p.established = t.status != TrackStatus::kTentative;
+    const TrackHypothesis& sel = t.hyps[static_cast<std::size_t>(t.selected)];
+    p.seen_length = sel.length_est.value_or(0.0);
+    p.seen_width = sel.width_est.value_or(0.0);
     out->push_back(p);
   }
 }
@@ -240,7 +283,7 @@ bool TrackManager::Measure(const Track& t, TrackHypothesis* h, const PointSet& p
 
 void TrackManager::Update(std::size_t index, const PointSet& points,
                           const Eigen::Vector2d& sensor_xy, std::uint64_t seed,
-                          TrackDebug* debug) {
+                          TrackDebug* debug, const RangeProfile* profile) {
   Track& t = tracks_[index];
   const std::int64_t tm = std::max(points.mean_utime, t.state_utime);
   const double dt = static_cast<double>(tm - t.state_utime) * 1e-6;
@@ -355,7 +398,10 @@ void TrackManager::Update(std::size_t index, const PointSet& points,
   Select(&t);
   Reseed(&t);
   if (any) TestMotion(&t);
-  if (any && !t.mover && !t.small_object) AlignToShape(&t);
+  if (any && !t.mover && !t.small_object && profile && !profile->empty()) {
+    AlignToFullFace(&t, points, sensor_xy, seed, *profile);
+  }
+  if (any && !t.mover && !t.small_object && !t.axis_from_full_face) AlignToShape(&t);
 
   if (debug) {
     const TrackHypothesis& h = t.hyps[static_cast<std::size_t>(t.selected)];
@@ -587,6 +633,54 @@ void TrackManager::AlignToShape(Track* t) const {
     h.shape.SwapLengthAndWidth();
     h.RefreshShape();
     std::swap(h.length_seen_full, h.width_seen_full);
+  }
+}
+
+void TrackManager::AlignToFullFace(Track* t, const PointSet& points,
+                                   const Eigen::Vector2d& sensor_xy, std::uint64_t seed,
+                                   const RangeProfile& profile) {
+  const TrackHypothesis& sel = t->hyps[static_cast<std::size_t>(t->selected)];
+  if (!sel.updated_this_scan || !sel.has_fit || sel.filter.kind != ModelKind::kIsm) return;
+  constexpr double kMargin = 0.5;  // [m] a return this much nearer than a face's end hides it
+  constexpr int kBins = 3;         // [-] bearing bins (0.2 deg) looked at beyond each end
+  for (int e = 0; e < sel.fit.num_edges; ++e) {
+    const FittedEdge& ed = sel.fit.edges[static_cast<std::size_t>(e)];
+    const Eigen::Vector2d a = ed.start + points.origin, b = ed.end + points.origin;
+    const double extent = (b - a).norm();
+    if (extent >= params_.vehicle_min_length || extent < 0.5 * params_.vehicle_min_width) continue;
+    // A corner's start is the corner itself (seen); an edge needs both ends free.
+    const bool start_free = sel.fit.kind == FitKind::kCorner ||
+                            profile.FreeBeyond(a, b, kMargin, kBins);
+    if (!start_free || !profile.FreeBeyond(b, a, kMargin, kBins)) continue;
+    // A fully seen face shorter than a vehicle: the front or rear. The heading is across it.
+    const double face_dir = std::atan2((b - a).y(), (b - a).x());
+    const double theta = sel.filter.x(4);
+    const bool along = std::abs(std::sin(AngleDiff(theta, face_dir))) < std::sin(DegToRad(45.0));
+    if (along) {
+      for (auto& h : t->hyps) {
+        if (h.filter.kind != ModelKind::kIsm) continue;
+        const Hypothesis old = ekf_.Convert(h.filter, ModelKind::kIsm, 0.5 * kPi);
+        h.shape.SwapLengthAndWidth();
+        h.RefreshShape();
+        std::swap(h.length_seen_full, h.width_seen_full);
+        // The centre moves with the axis (half the default length behind the face instead of
+        // half the width): it is measured afresh with the new heading; keeping the old position
+        // would turn the jump into a false velocity. The centre velocity carries over.
+        CentreMeasurement m;
+        if (Measure(*t, &h, points, sensor_xy, seed, old.x(4), false, &m) && m.z.allFinite()) {
+          Hypothesis ism = ekf_.InitIsm(m);
+          for (int i : {1, 3, 5}) {
+            ism.x(i) = old.x(i);
+            for (int j : {1, 3, 5}) ism.P(i, j) = old.P(i, j);
+          }
+          h.filter = ism;
+        } else {
+          h.filter = old;
+        }
+      }
+    }
+    t->axis_from_full_face = true;
+    return;
   }
 }
 

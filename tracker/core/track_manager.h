@@ -41,8 +41,12 @@
 // model, same heading), keeps its own inside fraction and noise scale, copies the shape, and
 // starts with the reported hypothesis' score history.
 //
-// Axis of a stationary object: the length axis is the longer side; when the width estimate
-// exceeds axis_swap_ratio times the length estimate, the ISM heading turns by 90 deg.
+// Axis of a stationary object. A fitted face whose both ends are seen (RangeProfile: beyond each
+// end, nothing nearer) and that is shorter than vehicle_min_length is a front or rear face: the
+// heading is turned by 90 deg if it runs along that face, and kept so (a parked row seen from
+// behind shows full rear faces and the first metre of each side; the longer-edge rule would
+// take the rear face for a side). Otherwise the length axis is the longer side: when the width
+// estimate exceeds axis_swap_ratio times the length estimate, the ISM heading turns by 90 deg.
 //
 // Life cycle. tentative -> confirmed after confirm_updates updates; a tentative track missed in
 // tentative_max_misses consecutive scans is deleted. A confirmed track that gets no update is
@@ -101,6 +105,11 @@ struct TrackManagerParams {
   double duplicate_overlap = 0.5;           // [-] overlap (of the smaller rectangle) of duplicates
   double range_sigma = 0.03;                // [m] LADAR range noise for fitting (Eq. 18's sigma)
   double fit_contour_deg = 0.2;             // [deg] fit the nearest return per bearing bin; 0: all
+  // 3-D clouds: a return enters that outline only if another return of its bin lies within
+  // contour_support_range of its range and contour_support_height or more above or below it
+  // (it stands on a vertical face; roofs and bonnets are grazed by single rings). 0: off.
+  double contour_support_height = 0.1;      // [m]
+  double contour_support_range = 0.25;      // [m]
   double default_length = 4.5;              // [m] rectangle of a new object before any estimate
   double default_width = 1.8;               // [m]
   double default_dimension_std = 1.0;       // [m] spread of that default
@@ -153,6 +162,7 @@ struct Track {
   int num_updates = 0;
   int consecutive_misses = 0;             // [-] scans without any update
   bool small_object = false;              // measured by centroid (poles, bushes, pedestrians)
+  bool axis_from_full_face = false;       // heading set by a fully seen short face (AlignToFullFace)
   std::vector<TrackHypothesis> hyps;
   int selected = 0;                       // index into hyps of the reported hypothesis
 };
@@ -213,6 +223,27 @@ struct PointSet {
   std::size_t size() const { return x.size(); }
 };
 
+// The nearest return per bearing bin around the sensor, over every return of a scan. It tells
+// whether a fitted face ends where the object ends (free space, or only farther returns, just
+// beyond the end: a full view of that face) or where something nearer hides the rest of it.
+class RangeProfile {
+ public:
+  // bin_deg: bearing bin [deg], > 0.
+  void Build(const Eigen::Vector2d& sensor_xy, const std::vector<double>& x,
+             const std::vector<double>& y, double bin_deg);
+  // True if, in the `bins` bearing bins just beyond `end` (on the side away from `inner`, the
+  // face's other end), no return lies nearer than end's range + margin.
+  bool FreeBeyond(const Eigen::Vector2d& end, const Eigen::Vector2d& inner, double margin,
+                  int bins) const;
+  bool empty() const { return nearest_.empty(); }
+
+ private:
+  int Bin(const Eigen::Vector2d& p) const;
+  Eigen::Vector2d sensor_ = Eigen::Vector2d::Zero();
+  double inv_bin_ = 0.0;  // [1/rad]
+  std::vector<float> nearest_;  // [m] per bin; +inf where no return
+};
+
 class TrackManager {
  public:
   // Throws std::invalid_argument naming the first invalid parameter.
@@ -223,8 +254,9 @@ class TrackManager {
   void Predict(std::int64_t utime, std::vector<PredictedObject>* out) const;
 
   // Updates track index with its returns; debug (optional) is filled for the scan's debug.
+  // profile (optional): the scan's nearest range per bearing, for the full-view test of faces.
   void Update(std::size_t index, const PointSet& points, const Eigen::Vector2d& sensor_xy,
-              std::uint64_t seed, TrackDebug* debug);
+              std::uint64_t seed, TrackDebug* debug, const RangeProfile* profile = nullptr);
   // The reported rectangle of a track at its state time.
   OrientedBox Box(std::size_t index) const;
   // Marks a track without returns on this scan.
@@ -252,6 +284,8 @@ class TrackManager {
   void TestMotion(Track* t);
   void SpawnVasms(Track* t) const;
   void AlignToShape(Track* t) const;
+  void AlignToFullFace(Track* t, const PointSet& points, const Eigen::Vector2d& sensor_xy,
+                       std::uint64_t seed, const RangeProfile& profile);
   void AlignVasm(Track* t) const;
   void AlignIsm(Track* t) const;
   bool SmallObject(const PointSet& points) const;

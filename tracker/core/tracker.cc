@@ -93,6 +93,17 @@ bool Tracker::CheckTime(std::int64_t utime, const char* what) {
     have_time_ = true;
     return true;
   }
+  // A jump forward longer than any track may coast (a clock step, a log that skips ahead): no
+  // track can survive it, and predicting them across it would only let stale tracks (with huge
+  // covariances) catch the new returns.
+  const std::int64_t forward_us = std::max(params_.input.time_jump_reset_us,
+                                           static_cast<std::int64_t>(params_.manager.coast_max_s * 1e6));
+  if (have_time_ && utime > latest_utime_ + forward_us) {
+    Reset(std::string(what) + " time jumped forward by " + Str((utime - latest_utime_) / 1000) + " ms");
+    latest_utime_ = utime;
+    have_time_ = true;
+    return true;
+  }
   if (!have_time_ || utime > latest_utime_) latest_utime_ = utime;
   have_time_ = true;
   return false;
@@ -206,6 +217,7 @@ bool Tracker::Process(const LadarScan& scan, bool forced, ScanOutput* out) {
   associator_.Run(predicted_, points_, segments_, pre.sensor_xy, &association_);
   out->num_segments = static_cast<std::int32_t>(segments_.segments.size());
 
+  const bool multi_ring = scan.num_rings > 1;
   auto fill = [&](const std::vector<std::int32_t>& idx) {
     PointSet& ps = point_set_;
     ps.x.resize(idx.size());
@@ -249,15 +261,47 @@ bool Tracker::Process(const LadarScan& scan, bool forced, ScanOutput* out) {
         thin_.emplace_back(bin * (std::int64_t{1} << 32) + r2, static_cast<std::int32_t>(k));
       }
       std::sort(thin_.begin(), thin_.end());
-      std::size_t w = 0;
       thin_x_.clear();
       thin_y_.clear();
-      for (std::size_t k = 0; k < thin_.size(); ++k) {
-        if (k > 0 && FloorDiv32(thin_[k].first) == FloorDiv32(thin_[k - 1].first)) continue;
-        const auto src = static_cast<std::size_t>(thin_[k].second);
-        thin_x_.push_back(ps.x[src]);
-        thin_y_.push_back(ps.y[src]);
-        ++w;
+      // 3-D clouds: the outline takes, per bin, the nearest return that stands on a vertical
+      // face: another return of the bin lies within support_range of its range at a height
+      // differing by support_height or more. A ring that grazes a horizontal surface (a roof,
+      // a bonnet) hits it at a fixed distance from the sensor, so those returns move with the
+      // ego vehicle; fitted as an edge they make a parked car look like a mover. Faces are hit
+      // by several rings at nearly the same range.
+      const double support_h = multi_ring ? params_.manager.contour_support_height : 0.0;
+      const double support_r2 = params_.manager.contour_support_range;
+      std::size_t k = 0;
+      while (k < thin_.size()) {
+        std::size_t end = k + 1;
+        while (end < thin_.size() && FloorDiv32(thin_[end].first) == FloorDiv32(thin_[k].first)) ++end;
+        std::size_t pick = k;
+        if (support_h > 0.0) {
+          pick = end;
+          auto range_of = [&](std::size_t a) {
+            return std::sqrt(static_cast<double>(thin_[a].first - FloorDiv32(thin_[a].first) * (std::int64_t{1} << 32)) * 1e-4);
+          };
+          for (std::size_t a = k; a < end && pick == end; ++a) {
+            const double ra = range_of(a);
+            const float ha = points_.height[static_cast<std::size_t>(idx[static_cast<std::size_t>(thin_[a].second)])];
+            for (std::size_t b = k; b < end; ++b) {
+              if (b == a) continue;
+              const double rb = range_of(b);
+              if (rb > ra + support_r2) break;  // sorted by range
+              const float hb = points_.height[static_cast<std::size_t>(idx[static_cast<std::size_t>(thin_[b].second)])];
+              if (std::abs(rb - ra) <= support_r2 && std::abs(hb - ha) >= support_h) {
+                pick = a;
+                break;
+              }
+            }
+          }
+        }
+        if (pick < end) {
+          const auto src = static_cast<std::size_t>(thin_[pick].second);
+          thin_x_.push_back(ps.x[src]);
+          thin_y_.push_back(ps.y[src]);
+        }
+        k = end;
       }
       ps.x.assign(thin_x_.begin(), thin_x_.end());
       ps.y.assign(thin_y_.begin(), thin_y_.end());
@@ -268,6 +312,7 @@ bool Tracker::Process(const LadarScan& scan, bool forced, ScanOutput* out) {
     return static_cast<std::uint64_t>(scan.utime) * 0x9E3779B97F4A7C15ull ^
            static_cast<std::uint64_t>(salt) * 0xC2B2AE3D27D4EB4Full;
   };
+  profile_.Build(pre.sensor_xy, points_.x, points_.y, std::max(0.05, params_.manager.fit_contour_deg));
   const std::size_t num_tracks = manager_->tracks().size();
   for (std::size_t j = 0; j < num_tracks; ++j) {
     const auto& idx = association_.track_points[j];
@@ -276,9 +321,13 @@ bool Tracker::Process(const LadarScan& scan, bool forced, ScanOutput* out) {
       continue;
     }
     fill(idx);
+    if (point_set_.size() == 0) {  // only returns off vertical faces (roofs): nothing to fit
+      manager_->Miss(j);
+      continue;
+    }
     TrackDebug dbg;
     manager_->Update(j, point_set_, pre.sensor_xy, seed_of(manager_->tracks()[j].id),
-                     debug_ ? &dbg : nullptr);
+                     debug_ ? &dbg : nullptr, &profile_);
     if (debug_) out->debug.push_back(std::move(dbg));
   }
   // New tracks, largest segments first; a segment mostly inside the rectangle of a track just
@@ -304,6 +353,7 @@ bool Tracker::Process(const LadarScan& scan, bool forced, ScanOutput* out) {
     }
     if (part_of_new) continue;
     fill(idx);
+    if (point_set_.size() == 0) continue;
     if (manager_->Create(point_set_, pre.sensor_xy, seed_of(-1 - static_cast<std::int64_t>(k)))) {
       created_.push_back(manager_->Box(manager_->tracks().size() - 1));
     }

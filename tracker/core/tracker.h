@@ -102,6 +102,7 @@ class Tracker {
   AssociationResult association_;
   PointSet point_set_;
   std::vector<OrientedBox> created_;
+  RangeProfile profile_;  // nearest return per bearing of the scan being processed
   std::vector<std::pair<std::int64_t, std::int32_t>> thin_;
   std::vector<float> thin_x_, thin_y_;
 

@@ -38,7 +38,13 @@ struct TrackerParams {
   PreprocessParams preprocess;
   SegmentationParams segmentation;
   AssociationParams association;
-  FitParams fit;
+  // The fitter's defaults, but inliers beyond a gap of 0.5 m (not 1 m) are dropped: the rear
+  // faces of a parked row are colinear and ~0.8 m apart, and one edge would run across them.
+  FitParams fit = [] {
+    FitParams f;
+    f.max_inlier_gap_m = 0.5;
+    return f;
+  }();
   IsmParams ism;
   VasmParams vasm;
   EkfParams ekf;

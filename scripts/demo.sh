@@ -241,8 +241,12 @@ say "all processes stopped ($wall s); evaluating $log"
 eval_args=("$log" --json "$metrics" --csv "$out/tracks.csv" --plots "$out/plots" -q)
 if [ -n "$kitti" ]; then
   # As vtrack-compare does for KITTI: labels are half a sweep after the scan's utime, and only
-  # camera 2's view (the labelled region) within 40 m is scored.
-  eval_args+=(--truth-time-offset half-sweep --region-camera --kitti-calib "$kitti/calib/$sequence.txt" --region-range 40)
+  # camera 2's view (the labelled region) within 40 m is scored. Without the scans in the log
+  # vtrack-eval cannot read the sweep (KITTI's is 100 ms: 0.05 s) nor the LADAR's mounting,
+  # which it then takes at the body origin: exact for KITTI, whose body frame is the Velodyne's.
+  offset=0.05
+  [ $record_scans = 1 ] && offset=half-sweep
+  eval_args+=(--truth-time-offset "$offset" --region-camera --kitti-calib "$kitti/calib/$sequence.txt" --region-range 40)
 fi
 "$bin/vtrack-eval" "${eval_args[@]}" > "$logs/vtrack-eval.txt" 2>&1 \
   || die "vtrack-eval failed:$(echo; tail -5 "$logs/vtrack-eval.txt")"

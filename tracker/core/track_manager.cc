@@ -680,6 +680,7 @@ void TrackManager::AlignToFullFace(Track* t, const PointSet& points,
       }
     }
     t->axis_from_full_face = true;
+    t->full_face_extent = extent;
     return;
   }
 }
@@ -799,8 +800,17 @@ void TrackManager::Report(std::int64_t utime, std::vector<TrackReport>* out) con
                               est_w <= params_.vehicle_max_width &&
                               std::max(est_l, est_w) >= params_.vehicle_min_length &&
                               std::min(est_l, est_w) >= params_.vehicle_min_width * 0.5;
+    // A stationary object seen in part (a parked car from one corner) is a vehicle if a face
+    // of a car's front or rear width was seen whole (both ends free, AlignToFullFace) and the
+    // rest fits a vehicle.
+    const bool full_face_vehicle = t.axis_from_full_face &&
+                                   t.full_face_extent >= params_.vehicle_min_width &&
+                                   t.full_face_extent <= params_.vehicle_max_width &&
+                                   est_l <= params_.vehicle_max_length &&
+                                   std::min(est_l, est_w) >= 0.5 * params_.vehicle_min_width;
     const bool vehicle = !t.small_object &&
-                         (vehicle_size || (t.mover && std::max(est_l, est_w) >= params_.vehicle_min_width));
+                         (vehicle_size || full_face_vehicle ||
+                          (t.mover && std::max(est_l, est_w) >= params_.vehicle_min_width));
     r.object_class = vehicle ? ObjectClass::kVehicle : ObjectClass::kOther;
     if (!vehicle && le && we) {  // clutter: its own size, not the vehicle default
       r.length = est_l;

@@ -119,7 +119,7 @@ struct TrackManagerParams {
   double vehicle_min_length = 2.5;          // [m]
   double vehicle_max_length = 20.0;         // [m]
   double vehicle_min_width = 1.2;           // [m]
-  double vehicle_max_width = 3.5;           // [m]
+  double vehicle_max_width = 2.8;           // [m] (road vehicles are at most 2.6 m wide)
   // Predicted trajectory for the planner.
   double prediction_horizon_s = 3.0;        // [s]
   double prediction_step_s = 0.1;           // [s]
@@ -163,6 +163,7 @@ struct Track {
   int consecutive_misses = 0;             // [-] scans without any update
   bool small_object = false;              // measured by centroid (poles, bushes, pedestrians)
   bool axis_from_full_face = false;       // heading set by a fully seen short face (AlignToFullFace)
+  double full_face_extent = 0.0;          // [m] that face's extent (a car's front or rear width)
   std::vector<TrackHypothesis> hyps;
   int selected = 0;                       // index into hyps of the reported hypothesis
 };

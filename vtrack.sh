@@ -94,6 +94,8 @@ case "$cmd" in
     install_packages "${pkgs_build[@]}" "${pkgs_fuzz[@]}"
     exec "$here/scripts/fuzz.sh" "$here" "${1:-60}" ;;
   demo)
+    # The demo's --help needs no packages and no build.
+    for a in "$@"; do case "$a" in -h|--help) exec "$here/scripts/demo.sh" --help ;; esac; done
     install_packages "${pkgs_build[@]}" "${pkgs_run[@]}"
     configure_and_build Release
     exec "$here/scripts/demo.sh" "$build_dir" "$@" ;;

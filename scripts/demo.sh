@@ -26,7 +26,7 @@
 set -euo pipefail
 
 usage() { sed -n '2,26p' "$0" | sed 's/^# \{0,1\}//'; }
-die() { echo "demo: $*" >&2; exit "${2:-1}"; }
+die() { echo "demo: $1" >&2; exit "${2:-1}"; }
 say() { printf '\033[1m[demo]\033[0m %s\n' "$*" >&2; }
 
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -181,7 +181,7 @@ else
   [ -n "$seed" ] && src+=(--seed "$seed")
   # The lap's length, as the simulator itself reports it.
   "$bin/vtrack-sim-log" "${src[@]}" --describe > "$logs/describe.txt" 2>&1 \
-    || die "the scenario does not load:$(echo; tail -5 "$logs/describe.txt")"
+    || die "the scenario or its options do not load:$(echo; tail -5 "$logs/describe.txt")" 2
   lead_s=3
 fi
 

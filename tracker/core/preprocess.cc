@@ -134,8 +134,21 @@ PreprocessResult Preprocessor::Run(const LadarScan& scan, const PoseHistory& pos
   const double max_r2 = params_.max_range * params_.max_range;
   const bool has_ring = scan.ring.size() == n;
   const bool has_dt = scan.dt_us.size() == n;
-  out->reserve(n);
-  body_z_.clear();
+  const bool cloud_3d = scan.num_rings >= params_.ground_min_rings;
+  const bool grid_ground = cloud_3d && params_.ground == PreprocessParams::Ground::kGrid;
+  const double inv_step = 1.0 / static_cast<double>(step);
+  // Written by index into arrays sized for every return, trimmed at the end (no push_back).
+  out->x.resize(n);
+  out->y.resize(n);
+  out->height.resize(n);
+  out->index.resize(n);
+  out->ring.resize(n);
+  double* const ox = out->x.data();
+  double* const oy = out->y.data();
+  float* const oh = out->height.data();
+  std::int32_t* const oi = out->index.data();
+  std::int16_t* const orng = out->ring.data();
+  std::size_t w = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const double px = scan.x[i], py = scan.y[i], pz = scan.z[i];
     if (!std::isfinite(px) || !std::isfinite(py) || !std::isfinite(pz)) {
@@ -152,7 +165,12 @@ PreprocessResult Preprocessor::Run(const LadarScan& scan, const PoseHistory& pos
       ++result.stats.bad_time;
       continue;
     }
-    const std::int64_t k = std::min<std::int64_t>(dt / step, num_intervals - 1);
+    // dt / step without a 64-bit division per return: a floating-point guess, corrected to the
+    // exact quotient.
+    std::int64_t q = static_cast<std::int64_t>(static_cast<double>(dt) * inv_step);
+    if (q * step > dt) --q;
+    if ((q + 1) * step <= dt) ++q;
+    const std::int64_t k = std::min<std::int64_t>(q, num_intervals - 1);
     const std::int64_t t0 = k * step;
     const std::int64_t t1 = std::min((k + 1) * step, sweep);
     const double f = t1 > t0 ? static_cast<double>(dt - t0) / static_cast<double>(t1 - t0) : 0.0;
@@ -163,12 +181,20 @@ PreprocessResult Preprocessor::Run(const LadarScan& scan, const PoseHistory& pos
     const double wy = (m(1, 0) + f * d(1, 0)) * px + (m(1, 1) + f * d(1, 1)) * py +
                       (m(1, 2) + f * d(1, 2)) * pz + (m(1, 3) + f * d(1, 3));
     const double zb = body_z(0) * px + body_z(1) * py + body_z(2) * pz + body_z(3);
-    out->push_back(wx, wy, static_cast<float>(zb), static_cast<std::int32_t>(i),
-                   has_ring ? scan.ring[i] : std::int16_t{0});
+    ox[w] = wx;
+    oy[w] = wy;
+    oh[w] = static_cast<float>(zb);
+    oi[w] = static_cast<std::int32_t>(i);
+    orng[w] = has_ring ? scan.ring[i] : std::int16_t{0};
+    ++w;
   }
+  out->x.resize(w);
+  out->y.resize(w);
+  out->height.resize(w);
+  out->index.resize(w);
+  out->ring.resize(w);
 
-  const bool cloud_3d = scan.num_rings >= params_.ground_min_rings;
-  if (cloud_3d && params_.ground == PreprocessParams::Ground::kGrid) {
+  if (grid_ground) {
     RemoveGround(result.sensor_xy, out, &result.stats);
   } else if (cloud_3d && params_.ground == PreprocessParams::Ground::kBand) {
     std::size_t w = 0;
@@ -204,14 +230,18 @@ void Preprocessor::RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts,
   cell_ground_.assign(static_cast<std::size_t>(side) * side, std::numeric_limits<float>::quiet_NaN());
   const std::size_t n = pts->size();
   point_cell_.resize(n);
+  const double* const px = pts->x.data();
+  const double* const py = pts->y.data();
+  const float* const ph = pts->height.data();
+  std::int32_t* const pc = point_cell_.data();
+  float* const cmin = cell_min_.data();
   for (std::size_t i = 0; i < n; ++i) {
     // Within max_range of the sensor, hence inside the grid (with one spare ring of cells).
-    const int cx = std::clamp(static_cast<int>((pts->x[i] - x0) / cell), 1, side - 2);
-    const int cy = std::clamp(static_cast<int>((pts->y[i] - y0) / cell), 1, side - 2);
+    const int cx = std::clamp(static_cast<int>((px[i] - x0) / cell), 1, side - 2);
+    const int cy = std::clamp(static_cast<int>((py[i] - y0) / cell), 1, side - 2);
     const std::int32_t c = cy * side + cx;
-    point_cell_[i] = c;
-    cell_min_[static_cast<std::size_t>(c)] =
-        std::min(cell_min_[static_cast<std::size_t>(c)], pts->height[i]);
+    pc[i] = c;
+    cmin[c] = std::min(cmin[c], ph[i]);
   }
   // Overall ground level: median of the lowest return per occupied cell within 20 m of the
   // sensor, where most cells see the road.
@@ -231,6 +261,8 @@ void Preprocessor::RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts,
     level = *mid;
   }
   const float tol = static_cast<float>(params_.ground_tolerance);
+  // Locals: the stores below could alias the parameters, which would be reloaded per return.
+  const double min_h = params_.min_height, max_h = params_.max_height;
   std::size_t w = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const std::int32_t c = point_cell_[i];
@@ -249,7 +281,7 @@ void Preprocessor::RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts,
       g = std::clamp(m, level - tol_here, level + tol_here);
     }
     const float h = pts->height[i] - g;
-    if (h < params_.min_height || h > params_.max_height) continue;
+    if (h < min_h || h > max_h) continue;
     pts->x[w] = pts->x[i];
     pts->y[w] = pts->y[i];
     pts->height[w] = h;

@@ -108,7 +108,6 @@ class Preprocessor {
   // Ground grid.
   std::vector<float> cell_min_, cell_ground_;
   std::vector<std::int32_t> point_cell_;
-  std::vector<float> body_z_;
 };
 
 const char* ToString(PreprocessParams::Ground g);

@@ -312,7 +312,11 @@ bool Tracker::Process(const LadarScan& scan, bool forced, ScanOutput* out) {
     return static_cast<std::uint64_t>(scan.utime) * 0x9E3779B97F4A7C15ull ^
            static_cast<std::uint64_t>(salt) * 0xC2B2AE3D27D4EB4Full;
   };
-  profile_.Build(pre.sensor_xy, points_.x, points_.y, std::max(0.05, params_.manager.fit_contour_deg));
+  // 3-D clouds only: a single-plane scanner's bearing spacing (0.5 deg or more) leaves bins of
+  // the profile empty between its returns, which would read as free space beyond a face's end.
+  if (multi_ring) {
+    profile_.Build(pre.sensor_xy, points_.x, points_.y, std::max(0.05, params_.manager.fit_contour_deg));
+  }
   const std::size_t num_tracks = manager_->tracks().size();
   for (std::size_t j = 0; j < num_tracks; ++j) {
     const auto& idx = association_.track_points[j];
@@ -327,7 +331,7 @@ bool Tracker::Process(const LadarScan& scan, bool forced, ScanOutput* out) {
     }
     TrackDebug dbg;
     manager_->Update(j, point_set_, pre.sensor_xy, seed_of(manager_->tracks()[j].id),
-                     debug_ ? &dbg : nullptr, &profile_);
+                     debug_ ? &dbg : nullptr, multi_ring ? &profile_ : nullptr);
     if (debug_) out->debug.push_back(std::move(dbg));
   }
   // New tracks, largest segments first; a segment mostly inside the rectangle of a track just

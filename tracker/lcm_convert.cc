@@ -6,11 +6,16 @@
 namespace vtrack {
 namespace {
 
-Eigen::Quaterniond Quat(const double q[4]) {
-  Eigen::Quaterniond r(q[0], q[1], q[2], q[3]);
+// A quaternion within 1e-3 of unit length becomes its rotation. Any other one becomes the
+// linear map it stands for, v -> q v q* (a rotation scaled by |q|^2), which the core refuses as
+// not a rotation. (Eigen's toRotationMatrix() assumes a unit quaternion: for (w, 0, 0, 0) it
+// gives the identity whatever w is, so an all-zero, unfilled orientation would pass as valid.)
+Eigen::Matrix3d Rotation(const double q[4]) {
+  const Eigen::Quaterniond r(q[0], q[1], q[2], q[3]);
   const double n = r.norm();
-  if (std::isfinite(n) && std::abs(n - 1.0) < 1e-3) r.normalize();
-  return r;
+  if (std::isfinite(n) && std::abs(n - 1.0) < 1e-3) return r.normalized().toRotationMatrix();
+  if (!(n > 0.0 && std::isfinite(n))) return Eigen::Matrix3d::Constant(n);  // zero, NaN, Inf
+  return r.normalized().toRotationMatrix() * (n * n);
 }
 
 void BoxTo(const OrientedBox& b, double out[5]) {
@@ -29,7 +34,7 @@ LadarScan ScanFromLcm(ladar_scan_t&& msg) {
   s.seq = msg.seq;
   s.sensor_id = std::move(msg.sensor_id);
   s.body_from_sensor = Eigen::Isometry3d::Identity();
-  s.body_from_sensor.linear() = Quat(msg.sensor_orientation).toRotationMatrix();
+  s.body_from_sensor.linear() = Rotation(msg.sensor_orientation);
   s.body_from_sensor.translation() =
       Eigen::Vector3d(msg.sensor_pos[0], msg.sensor_pos[1], msg.sensor_pos[2]);
   s.sweep_duration_us = msg.sweep_duration_us;
@@ -49,7 +54,7 @@ EgoPose PoseFromLcm(const pose_t& msg) {
   EgoPose p;
   p.utime = msg.utime;
   p.world_from_body = Eigen::Isometry3d::Identity();
-  p.world_from_body.linear() = Quat(msg.orientation).toRotationMatrix();
+  p.world_from_body.linear() = Rotation(msg.orientation);
   p.world_from_body.translation() = Eigen::Vector3d(msg.pos[0], msg.pos[1], msg.pos[2]);
   return p;
 }

@@ -81,6 +81,7 @@ void Tracker::Reset(const std::string& why) {
   manager_->Clear();
   have_scan_ = false;
   have_time_ = false;
+  have_seq_ = false;
   events_.push_back({"reset", "tracker reset: " + why});
 }
 
@@ -89,6 +90,17 @@ bool Tracker::CheckTime(std::int64_t utime, const char* what) {
   if (have_time_ && utime < latest_utime_ - params_.input.time_jump_reset_us) {
     Reset(std::string(what) + " time jumped back by " +
           Str((latest_utime_ - utime) / 1000) + " ms (looped log?)");
+    latest_utime_ = utime;
+    have_time_ = true;
+    return true;
+  }
+  // A jump forward longer than any track may coast (a clock step, a log that skips ahead): no
+  // track can survive it, and predicting them across it would only let stale tracks (with huge
+  // covariances) catch the new returns.
+  const std::int64_t forward_us = std::max(params_.input.time_jump_reset_us,
+                                           static_cast<std::int64_t>(params_.manager.coast_max_s * 1e6));
+  if (have_time_ && utime > latest_utime_ + forward_us) {
+    Reset(std::string(what) + " time jumped forward by " + Str((utime - latest_utime_) / 1000) + " ms");
     latest_utime_ = utime;
     have_time_ = true;
     return true;
@@ -122,6 +134,19 @@ void Tracker::AddPose(const EgoPose& pose, std::vector<ScanOutput>* out) {
     case PoseHistory::AddResult::kOk: break;
     case PoseHistory::AddResult::kDuplicate:
       Reject("pose_repeated", 1, "pose at " + Str(pose.utime) + " repeats the previous time");
+  // Scans lost on the way (LCM drops a datagram, or a fragmented message with a fragment
+  // missing, without a word) show as gaps in the sensor's seq: counted as "scan_seq_gap", one per
+  // missing scan. A jump of more than kMaxSeqGap is a renumbered sensor, not loss.
+  constexpr std::uint64_t kMaxSeqGap = 100'000;
+  if (have_seq_ && scan.seq > last_seq_) {
+    const std::uint64_t gap = static_cast<std::uint64_t>(scan.seq) - static_cast<std::uint64_t>(last_seq_) - 1;
+    if (gap > 0 && gap <= kMaxSeqGap) {
+      Reject("scan_seq_gap", static_cast<std::int64_t>(gap),
+             Str(static_cast<std::int64_t>(gap)) + " scans missing before scan " + Str(scan.seq));
+    }
+  }
+  if (!have_seq_ || scan.seq > last_seq_) last_seq_ = scan.seq;
+  have_seq_ = true;
       return;
     case PoseHistory::AddResult::kOutOfOrder:
       Reject("pose_out_of_order", 1,
@@ -138,6 +163,10 @@ void Tracker::AddScan(LadarScan&& scan, std::vector<ScanOutput>* out) {
     ++scans_dropped_;
     Reject(reason, 1, "scan " + Str(scan.seq) + " at " + Str(scan.utime) + ": " + msg);
   };
+  const Eigen::Matrix3d mount = scan.body_from_sensor.linear();
+  if ((mount.transpose() * mount - Eigen::Matrix3d::Identity()).norm() > 1e-3) {
+    return drop("bad_scan", "mounting orientation is not a rotation");
+  }
   if (scan.y.size() != n || scan.z.size() != n ||
       (!scan.dt_us.empty() && scan.dt_us.size() != n) ||
       (!scan.ring.empty() && scan.ring.size() != n)) {

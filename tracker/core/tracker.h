@@ -110,6 +110,8 @@ class Tracker {
   bool have_time_ = false;
   std::int64_t last_scan_utime_ = 0;
   bool have_scan_ = false;
+  std::int64_t last_seq_ = 0;  // newest scan seq received (for scan_seq_gap)
+  bool have_seq_ = false;
   std::int64_t scans_received_ = 0, scans_processed_ = 0, scans_dropped_ = 0;
   std::int64_t poses_received_ = 0, resets_ = 0;
   std::map<std::string, std::int64_t> rejects_;

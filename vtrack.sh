@@ -3,7 +3,7 @@
 #
 #   ./vtrack.sh demo [DEMO OPTIONS]   the main job (see ./vtrack.sh demo --help)
 #   ./vtrack.sh test [CTEST ARGS]     every test (what CI runs)
-#   ./vtrack.sh bench [--json F]      the benchmarks
+#   ./vtrack.sh bench [--json F]      the benchmarks: one table + bench-results.json
 #   ./vtrack.sh fuzz [SECONDS]        build the libFuzzer harnesses (clang) and run each SECONDS (60)
 #   ./vtrack.sh build                 set up and build only
 #   ./vtrack.sh deps                  install the Debian packages only
@@ -23,7 +23,8 @@ pkgs_build=(g++ make cmake pkg-config
   libgtest-dev libbenchmark-dev default-jdk-headless)
 pkgs_run=(iproute2 procps zstd tar)
 pkgs_test=(xvfb xauth default-jre libjchart2d-java)
-pkgs_bench=()
+pkgs_bench=(jq)
+pkgs_bench_optional=(libpcl-dev)  # the peer of pcl_bench; without it that comparison is skipped
 pkgs_fuzz=(clang libclang-rt-14-dev)
 
 usage() { sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; }
@@ -80,16 +81,14 @@ case "$cmd" in
     ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" "$@"
     log "tests passed in $(( $(date +%s) - start )) s" ;;
   bench)
+    # Options go to scripts/bench.sh: [--json F] [--all] [--soak-minutes M] [--e2e-scans N].
     install_packages "${pkgs_build[@]}" "${pkgs_run[@]}" "${pkgs_bench[@]}"
-    configure_and_build Release -DVTRACK_BUILD_BENCHMARKS=ON
-    found=0
-    for b in "$build_dir"/bench/*; do
-      [ -x "$b" ] || continue
-      found=1
-      log "benchmark $(basename "$b")"
-      "$b" "$@"
-    done
-    [ $found = 1 ] || log "no benchmark programs are built yet" ;;
+    ( install_packages "${pkgs_bench_optional[@]}" ) ||
+      log "optional ${pkgs_bench_optional[*]} not installed: the PCL comparison is skipped"
+    log "building the benchmarks (Release) in $build_dir with $jobs jobs"
+    cmake -S "$here" -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DVTRACK_BUILD_BENCHMARKS=ON >/dev/null
+    cmake --build "$build_dir" -j "$jobs" --target vtrack_bench_programs
+    exec "$here/scripts/bench.sh" "$build_dir" "$@" ;;
   fuzz)
     install_packages "${pkgs_build[@]}" "${pkgs_fuzz[@]}"
     exec "$here/scripts/fuzz.sh" "$here" "${1:-60}" ;;

@@ -1,0 +1,197 @@
+// End-to-end latency of the live tracker over LCM: scan published on LADAR_SCAN -> its
+// track_list_t received on TRACKS, with the real vtrack-tracker process, full KITTI HDL-64E scans
+// (sequence 0000, 98k-124k returns, ~2.7 MB per message) at 10 Hz and ego poses at 100 Hz.
+// The poses through each scan's last return time are published before the scan (as on a vehicle,
+// where the pose source runs ahead of the sweep), so the latency is decoding + tracking +
+// encoding + the bus, not waiting for poses. The first --warmup scans are not counted.
+//
+// udpm only inside a private loopback-only network namespace (scripts/vtrack-netns); elsewhere
+// it exits 77 (skipped). Wall-clock times (steady clock) of this process.
+//
+//   scripts/vtrack-netns build/bench/e2e_latency --bin-dir build/bin [--scans 150] [--json F]
+#include <lcm/lcm-cpp.hpp>
+
+#include <boost/program_options.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "lcmtypes/util/process.h"
+#include "sensor_driver/kitti/kitti_sequence.h"
+#include "tests/bench/bench_data.h"
+#include "tests/support/subprocess.h"
+#include "vtrack/ladar_scan_t.hpp"
+#include "vtrack/pose_t.hpp"
+#include "vtrack/track_list_t.hpp"
+#include "vtrack/tracker_status_t.hpp"
+
+namespace po = boost::program_options;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+struct Receiver {
+  std::map<std::int64_t, Clock::time_point> tracks_at;  // scan utime -> TRACKS arrival
+  bool status_seen = false;
+  std::int64_t decode_errors = 0;
+
+  void OnTracks(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    const auto now = Clock::now();
+    vtrack::track_list_t msg;
+    if (msg.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) < 0) {
+      ++decode_errors;
+      return;
+    }
+    tracks_at.emplace(msg.utime, now);
+  }
+  void OnStatus(const lcm::ReceiveBuffer*, const std::string&) { status_seen = true; }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string bin_dir, kitti_dir = vtrack::bench::KittiDir(), json, url, log;
+  int scans = 150, warmup = 10;
+  double rate_hz = 10.0;
+  po::options_description desc(
+      "e2e_latency: scan published -> TRACKS received, live vtrack-tracker over LCM (udpm, private "
+      "network namespace only)\nOptions");
+  desc.add_options()("help,h", "show this help")(
+      "bin-dir", po::value(&bin_dir)->required(), "directory holding vtrack-tracker")(
+      "kitti", po::value(&kitti_dir)->default_value(kitti_dir), "KITTI tracking_0000 directory")(
+      "scans", po::value(&scans)->default_value(scans), "scans to publish (frames 1.., cycled)")(
+      "warmup", po::value(&warmup)->default_value(warmup), "first scans not counted")(
+      "rate-hz", po::value(&rate_hz)->default_value(rate_hz), "scan rate [Hz]")(
+      "lcm-url", po::value(&url)->default_value("udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608"),
+      "LCM URL (udpm)")("tracker-log", po::value(&log)->default_value("/tmp/e2e_latency_tracker.log"),
+                        "the tracker's stdout/stderr")("json", po::value(&json), "write the figures here");
+  po::variables_map vm;
+  try {
+    po::store(po::parse_command_line(argc, argv, desc), vm);
+    if (vm.count("help")) {
+      std::cout << desc << "\n";
+      return 0;
+    }
+    po::notify(vm);
+  } catch (const std::exception& e) {
+    std::cerr << "e2e_latency: " << e.what() << "\n" << desc << "\n";
+    return 2;
+  }
+  if (scans <= warmup || scans < 1 || warmup < 0 || !(rate_hz > 0.0 && rate_hz <= 100.0)) {
+    std::cerr << "e2e_latency: need scans > warmup >= 0 and rate-hz in (0, 100]; got scans=" << scans
+              << " warmup=" << warmup << " rate-hz=" << rate_hz << "\n";
+    return 2;
+  }
+  if (url.rfind("udpm://", 0) == 0 && !vtrack::lcm_util::InPrivateLoopbackNamespace()) {
+    std::cerr << "e2e_latency: not in a private loopback-only network namespace; run through "
+                 "scripts/vtrack-netns so multicast stays on this machine (skipped)\n";
+    return 77;
+  }
+
+  // Scans and poses, prepared before the clock starts.
+  vtrack::kitti::SequenceOptions o;
+  o.dir = kitti_dir;
+  o.cache_dir = VTRACK_BINARY_DIR "/kitti_cache";
+  std::vector<vtrack::ladar_scan_t> frames;
+  std::unique_ptr<vtrack::kitti::Sequence> seq;
+  try {
+    seq = std::make_unique<vtrack::kitti::Sequence>(o);
+    const int n = std::min(seq->num_frames() - 1, scans);
+    std::fprintf(stderr, "e2e_latency: reading %d KITTI frames\n", n);
+    for (int i = 1; i <= n; ++i) frames.push_back(seq->Scan(i));
+  } catch (const std::exception& e) {
+    std::cerr << "e2e_latency: KITTI data: " << e.what() << "\n";
+    return 1;
+  }
+
+  lcm::LCM lcm(url);
+  if (!lcm.good()) {
+    std::cerr << "e2e_latency: cannot open LCM at " << url << "\n";
+    return 1;
+  }
+  Receiver rx;
+  lcm.subscribe("TRACKS", &Receiver::OnTracks, &rx);
+  lcm.subscribe("TRACKER_STATUS", &Receiver::OnStatus, &rx);
+  auto handle_until = [&](Clock::time_point deadline) {
+    for (;;) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+      if (left <= 0) return;
+      lcm.handleTimeout(static_cast<int>(std::max<long>(1, left)));
+    }
+  };
+
+  vtrack::testing::Subprocess tracker({bin_dir + "/vtrack-tracker", "--lcm-url", url}, log);
+  // Ready once it publishes its status (it subscribes before its first status).
+  const auto ready_deadline = Clock::now() + std::chrono::seconds(20);
+  while (!rx.status_seen && Clock::now() < ready_deadline) handle_until(Clock::now() + std::chrono::milliseconds(100));
+  if (!rx.status_seen) {
+    std::cerr << "e2e_latency: no TRACKER_STATUS from vtrack-tracker within 20 s (log: " << log << ")\n";
+    return 1;
+  }
+
+  // Message times advance by the scan period on every cycle through the frames.
+  const std::int64_t period_us = static_cast<std::int64_t>(1e6 / rate_hz);
+  const std::int64_t first = frames.front().utime;
+  const std::int64_t seq_span = frames.back().utime + period_us - first;
+  std::int64_t next_pose = seq->FirstPoseUtime() + 10'000;
+  std::map<std::int64_t, Clock::time_point> published;
+  std::vector<std::int64_t> counted;
+  auto tick = Clock::now();
+  for (int k = 0; k < scans; ++k) {
+    const std::size_t f = static_cast<std::size_t>(k) % frames.size();
+    const std::int64_t shift = static_cast<std::int64_t>(k / frames.size()) * seq_span;
+    vtrack::ladar_scan_t& scan = frames[f];
+    const std::int64_t orig_utime = scan.utime;
+    scan.utime = orig_utime + shift;
+    scan.seq = k;
+    const std::int64_t end = scan.utime + scan.sweep_duration_us;
+    for (; next_pose <= end + 10'000; next_pose += 10'000) {
+      const std::int64_t t = next_pose - (next_pose - first) / seq_span * seq_span;  // in the sequence
+      vtrack::pose_t p = seq->PoseAt(std::clamp(t, seq->FirstPoseUtime(), seq->LastPoseUtime()));
+      p.utime = next_pose;
+      lcm.publish("EGO_POSE", &p);
+    }
+    published[scan.utime] = Clock::now();
+    lcm.publish("LADAR_SCAN", &scan);
+    if (k >= warmup) counted.push_back(scan.utime);
+    scan.utime = orig_utime;
+    tick += std::chrono::microseconds(period_us);
+    handle_until(tick);
+    if (k % 50 == 49) std::fprintf(stderr, "e2e_latency: %d/%d scans published\n", k + 1, scans);
+  }
+  handle_until(Clock::now() + std::chrono::seconds(2));
+  const int status = tracker.Stop();
+
+  std::vector<double> ms;
+  int lost = 0;
+  for (const std::int64_t u : counted) {
+    const auto it = rx.tracks_at.find(u);
+    if (it == rx.tracks_at.end()) {
+      ++lost;
+      continue;
+    }
+    ms.push_back(std::chrono::duration<double, std::milli>(it->second - published[u]).count());
+  }
+  if (ms.empty()) {
+    std::cerr << "e2e_latency: no TRACKS answered a counted scan (log: " << log << ")\n";
+    return 1;
+  }
+  const double med = vtrack::bench::Percentile(ms, 50), p99 = vtrack::bench::Percentile(ms, 99),
+               mx = vtrack::bench::Percentile(ms, 100);
+  std::printf("e2e latency over LCM (%zu scans at %.0f Hz, %zu answered, %d lost): median %.2f ms, p99 %.2f ms, max %.2f ms\n",
+              counted.size(), rate_hz, ms.size(), lost, med, p99, mx);
+  if (!json.empty()) {
+    std::ofstream os(json);
+    os << "{\"e2e_latency_ms_median\": " << med << ", \"e2e_latency_ms_p99\": " << p99
+       << ", \"e2e_latency_ms_max\": " << mx << ", \"e2e_scans\": " << counted.size()
+       << ", \"e2e_lost\": " << lost << ", \"e2e_rate_hz\": " << rate_hz
+       << ", \"tracker_exit_status\": " << status << "}\n";
+  }
+  return 0;
+}

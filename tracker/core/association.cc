@@ -224,8 +224,8 @@ void Associator::BuildParts(const std::vector<PredictedObject>& tracks, const Wo
       const double margin = GateMargin(tracks[j]);
       const double hl = 0.5 * tracks[j].box.length + margin, hw = 0.5 * tracks[j].box.width + margin;
       const BoxFrame frame(tracks[j].box);
-      int inside = 0;
-      for (std::int32_t k = s.begin; k < s.end; ++k) {
+      int inside = 0;  // counted up to split_min_points: all the claim needs
+      for (std::int32_t k = s.begin; k < s.end && inside < params_.split_min_points; ++k) {
         const auto i = static_cast<std::size_t>(segments.point[static_cast<std::size_t>(k)]);
         const Eigen::Vector2d q = frame.To(pts.x[i], pts.y[i]);
         if (std::abs(q.x()) <= hl && std::abs(q.y()) <= hw) ++inside;

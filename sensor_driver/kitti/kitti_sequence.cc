@@ -294,7 +294,8 @@ void Sequence::BuildGroundTruth() {
   }
 
   const int w = options_.velocity_half_window;
-  for (auto& [id, members] : tracks) {
+  for (auto& track : tracks) {
+    auto& members = track.second;  // not a structured binding: clang 14 cannot capture those
     std::sort(members.begin(), members.end());
     auto obj = [&](std::size_t k) -> vtrack::object_t& {
       return objects_[static_cast<std::size_t>(members[k].first)][members[k].second].object;

@@ -172,6 +172,10 @@ void Read(const YAML::Node& root, const std::string& origin, TrackerParams* p) {
     s.Get("ignore_max_extent", &q.ignore_max_extent);
     s.Get("split_min_points", &q.split_min_points);
     s.Get("min_slant_deg", &q.min_slant_deg);
+    s.Get("join_max_piece", &q.join_max_piece);
+    s.Get("join_max_gap", &q.join_max_gap);
+    s.Get("join_max_deg", &q.join_max_deg);
+    s.Get("join_max_extent", &q.join_max_extent);
     s.Done();
   }
   {
@@ -258,6 +262,9 @@ void Read(const YAML::Node& root, const std::string& origin, TrackerParams* p) {
     s.Get("fit_contour_deg", &q.fit_contour_deg);
     s.Get("contour_support_height", &q.contour_support_height);
     s.Get("contour_support_range", &q.contour_support_range);
+    s.Get("outline_min_slant_deg", &q.outline_min_slant_deg);
+    s.Get("outline_min_points", &q.outline_min_points);
+    s.Get("outline_min_edge_inliers", &q.outline_min_edge_inliers);
     s.Get("default_length", &q.default_length);
     s.Get("default_width", &q.default_width);
     s.Get("default_dimension_std", &q.default_dimension_std);

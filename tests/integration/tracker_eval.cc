@@ -113,6 +113,22 @@ EvalResult EvaluateTracks(const std::string& truth_log, const std::string& track
       const int j = assign[static_cast<std::size_t>(i)];
       const bool matched = j >= 0 && j < static_cast<int>(cands.size()) &&
                            cost[static_cast<std::size_t>(i * cols + j)] < opt.gate;
+      if (o.id == opt.trace_vehicle) {
+        char buf[300];
+        std::snprintf(buf, sizeof(buf), "t=%.2f s: vehicle %lld at (%.2f, %.2f) yaw %.0f deg, %d returns, %.1f m from ego; matched %lld",
+                      (utime - truth.begin()->first) * 1e-6, static_cast<long long>(o.id), o.x, o.y,
+                      RadToDeg(o.yaw), o.num_points, (Eigen::Vector2d(o.x, o.y) - ego_xy).norm(),
+                      j >= 0 && j < static_cast<int>(cands.size()) ? static_cast<long long>(cands[static_cast<std::size_t>(j)]->id) : -1LL);
+        res.trace.push_back(buf);
+        for (const auto& t : tl->second.tracks) {
+          const double d = std::hypot(t.x - o.x, t.y - o.y);
+          if (d > 5.0) continue;
+          std::snprintf(buf, sizeof(buf), "    track %lld at %.2f m: (%.2f, %.2f) theta %.0f deg, %.1f x %.1f m, status %d, class %d, %.1f m/s, %d updates, %d hyps",
+                        static_cast<long long>(t.id), d, t.x, t.y, RadToDeg(t.theta), t.length, t.width, t.status,
+                        t.object_class, t.speed, t.num_updates, t.num_hypotheses);
+          res.trace.push_back(buf);
+        }
+      }
       const auto fs = first_seen.find(o.id);
       const auto ls = last_seen.find(o.id);
       const bool due = fs != first_seen.end() &&
@@ -131,11 +147,36 @@ EvalResult EvaluateTracks(const std::string& truth_log, const std::string& track
       const track_t& t = *cands[static_cast<std::size_t>(j)];
       if (due) ++res.matched;
       auto& ids = res.ids[o.id];
+      const double d = std::hypot(t.x - o.x, t.y - o.y);
       if (ids.empty() || ids.back() != t.id) {
-        if (!ids.empty()) ++res.id_switches;
+        if (!ids.empty()) {
+          ++res.id_switches;
+          if (res.switches.size() < 40) {
+            const std::int64_t old_id = ids.back();
+            const track_t* old = nullptr;
+            for (const auto& c : tl->second.tracks) {
+              if (c.id == old_id) old = &c;
+            }
+            char old_desc[160] = "no longer reported";
+            if (old) {
+              std::snprintf(old_desc, sizeof(old_desc), "at %.2f m, %.1f x %.1f m, status %d, %d hyps",
+                            std::hypot(old->x - o.x, old->y - o.y), old->length, old->width,
+                            old->status, old->num_hypotheses);
+            }
+            char buf[400];
+            std::snprintf(buf, sizeof(buf),
+                          "t=%.2f s: vehicle %lld (%.1f x %.1f m, %.1f m/s, %.1f m from ego, %s) "
+                          "track %lld -> %lld (at %.2f m, %.1f x %.1f m, age %.1f s, %d hyps); old %s",
+                          (utime - truth.begin()->first) * 1e-6, static_cast<long long>(o.id),
+                          o.length, o.width, o.speed, (Eigen::Vector2d(o.x, o.y) - ego_xy).norm(),
+                          due ? "due" : "not yet due", static_cast<long long>(old_id),
+                          static_cast<long long>(t.id), d, t.length, t.width, t.age,
+                          t.num_hypotheses, old_desc);
+            res.switches.push_back(buf);
+          }
+        }
         ids.push_back(t.id);
       }
-      const double d = std::hypot(t.x - o.x, t.y - o.y);
       if (!due) continue;  // errors are scored from the first second in view on, like misses
       ++pairs;
       pos_sq += d * d;

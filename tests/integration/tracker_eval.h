@@ -22,6 +22,7 @@ struct EvalOptions {
   double in_view_delay_s = 1.0;  // [s] grace period after a vehicle first has returns
   double gate = 2.0;             // [m] centre distance for a match
   double occlusion_grace_s = 0.5;  // [s] a vehicle without returns for longer is not due
+  std::int64_t trace_vehicle = -1;  // [-] if >= 0: EvalResult::trace describes this vehicle per scan
 };
 
 struct EvalResult {
@@ -39,6 +40,11 @@ struct EvalResult {
   int max_hyps_stationary_truth = 0;
   std::vector<std::string> misses;  // first few misses, described
   std::vector<std::string> stationary_multi;  // first few parked vehicles on multi-hypothesis tracks
+  // First few identity switches, described: time, vehicle (size, speed, range), due or not, the
+  // old and new track (distance to the vehicle, size, whether the old one is still reported).
+  std::vector<std::string> switches;
+  // EvalOptions::trace_vehicle per scan: its state and every track within 5 m.
+  std::vector<std::string> trace;
   std::map<std::int64_t, std::vector<std::int64_t>> ids;  // vehicle -> track ids in order
   std::map<std::int64_t, double> vehicle_pos_rmse;        // [m] per vehicle
   std::map<std::int64_t, double> vehicle_heading_rmse_deg;  // [deg] axis error per vehicle

@@ -1,20 +1,25 @@
-// tracker-eval-scores TRUTH_LOG TRACKS_LOG: prints the integration tests' scores of a tracker
+// tracker-eval-scores TRUTH_LOG TRACKS_LOG [TRACE_VEHICLE_ID]: prints the integration tests' scores of a tracker
 // output (tracker_eval.h); how the figures in tracker/README.md were made.
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include "tests/integration/tracker_eval.h"
 
 int main(int argc, char** argv) {
-  if (argc != 3) {
-    std::fprintf(stderr, "usage: %s TRUTH_LOG TRACKS_LOG\n", argv[0]);
+  if (argc != 3 && argc != 4) {
+    std::fprintf(stderr, "usage: %s TRUTH_LOG TRACKS_LOG [TRACE_VEHICLE_ID]\n", argv[0]);
     return 2;
   }
   try {
-    const auto r = vtrack::testing::EvaluateTracks(argv[1], argv[2]);
+    vtrack::testing::EvalOptions opt;
+    if (argc == 4) opt.trace_vehicle = std::stoll(argv[3]);
+    const auto r = vtrack::testing::EvaluateTracks(argv[1], argv[2], opt);
+    for (const auto& m : r.trace) std::printf("%s\n", m.c_str());
     std::printf("%s\n", vtrack::testing::Summary(r).c_str());
     for (const auto& m : r.misses) std::printf("  %s\n", m.c_str());
     for (const auto& m : r.stationary_multi) std::printf("  %s\n", m.c_str());
+    for (const auto& m : r.switches) std::printf("  switch %s\n", m.c_str());
     for (const auto& [id, ids] : r.ids) {
       std::printf("  vehicle %lld: tracks", static_cast<long long>(id));
       for (auto t : ids) std::printf(" %lld", static_cast<long long>(t));

@@ -174,12 +174,14 @@ TEST(TrackerLiveTest, UrbanIntersectionLiveWith64LayerScans) {
     for (const auto id : ids) std::printf(" %lld", static_cast<long long>(id));
     std::printf("\n");
   }
+  for (const auto& m : r.switches) std::printf("  switch %s\n", m.c_str());
   // Issue 5 asks for every due vehicle tracked and no identity switch. Not met yet on this scene
-  // (tracker/README.md, open issues: 97.0% of due (vehicle, scan) pairs on this lap, 29 identity
-  // switches, on parked rows seen at a grazing angle). Asserted: about what it achieves, so
-  // that a regression fails, with the misses and switches printed above.
-  EXPECT_GE(r.matched * 100, r.due * 96) << (r.misses.empty() ? "" : r.misses.front());
-  EXPECT_LE(r.id_switches, 35);
+  // (tracker/README.md, open issues: 98.2% of due (vehicle, scan) pairs on this lap and 3
+  // identity switches, with every scan processed; lot cars first seen merged at 35-45 m).
+  // Asserted: about what it achieves, with a margin for a scan or two lost on the bus, so that a
+  // regression fails, with the misses and switches printed above.
+  EXPECT_GE(r.matched * 1000, r.due * 975) << (r.misses.empty() ? "" : r.misses.front());
+  EXPECT_LE(r.id_switches, 6);
   EXPECT_EQ(r.max_hyps_not_moving, 1);
   EXPECT_LE(r.max_hyps_moving, 4);
   EXPECT_EQ(r.max_hyps_stationary_truth, 1);  // no parked car is judged a mover

@@ -115,7 +115,130 @@ std::string AssociationParams::FirstProblem() const {
   if (split_min_points < 1) return Bad("split_min_points", split_min_points, "must be >= 1");
   if (!(min_slant_deg >= 0.0 && min_slant_deg < 90.0))
     return Bad("min_slant_deg", min_slant_deg, "must be in [0, 90)");
+  if (!(join_max_piece >= 0.0 && join_max_piece <= 10.0))
+    return Bad("join_max_piece", join_max_piece, "must be in [0, 10] m");
+  if (!(join_max_gap > 0.0 && join_max_gap <= 20.0))
+    return Bad("join_max_gap", join_max_gap, "must be in (0, 20] m");
+  if (!(join_max_deg >= 0.0 && join_max_deg < 90.0))
+    return Bad("join_max_deg", join_max_deg, "must be in [0, 90) deg");
+  if (!(join_max_extent >= join_max_piece && join_max_extent <= 50.0))
+    return Bad("join_max_extent", join_max_extent, "must be in [join_max_piece, 50] m");
   return {};
+}
+
+int JoinGrazingPieces(const WorldPoints& pts, const Eigen::Vector2d& sensor_xy,
+                      const AssociationParams& params, Segments* segments) {
+  auto& segs = segments->segments;
+  if (params.join_max_piece <= 0.0 || segs.size() < 2) return 0;
+  struct Piece {
+    double bearing;   // [rad] of the centroid seen from the sensor
+    double range;     // [m]
+    std::int32_t seg;
+  };
+  std::vector<Piece> pieces;
+  for (std::size_t k = 0; k < segs.size(); ++k) {
+    const Segment& g = segs[k];
+    if ((g.max - g.min).norm() >= params.join_max_piece) continue;
+    const Eigen::Vector2d d = g.centroid - sensor_xy;
+    pieces.push_back({std::atan2(d.y(), d.x()), d.norm(), static_cast<std::int32_t>(k)});
+  }
+  const std::size_t n = pieces.size();
+  if (n < 2) return 0;
+  std::sort(pieces.begin(), pieces.end(), [](const Piece& a, const Piece& b) {
+    return a.bearing < b.bearing || (a.bearing == b.bearing && a.seg < b.seg);
+  });
+  // Candidate pairs. For B to lie within join_max_deg of A's ray at a distance <= gap, its
+  // bearing differs by at most asin(gap * sin(deg) / range(B)), range(B) >= range(A) - gap:
+  // pieces sorted by bearing are scanned within that window (both ways round the circle).
+  const double sin_max = std::sin(DegToRad(params.join_max_deg));
+  const double gap = params.join_max_gap;
+  struct Pair {
+    double dist;
+    std::int32_t a, b;  // indices into segs
+  };
+  std::vector<Pair> pairs;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double r_min = std::max(0.5, pieces[i].range - gap);
+    const double window = std::asin(std::min(1.0, gap * sin_max / r_min)) + 1e-9;
+    for (std::size_t step = 1; step < n; ++step) {
+      const Piece& q = pieces[(i + step) % n];
+      double db = q.bearing - pieces[i].bearing;
+      if (db < 0.0) db += 2.0 * kPi;
+      if (db > window) break;
+      const Eigen::Vector2d ca = segs[static_cast<std::size_t>(pieces[i].seg)].centroid;
+      const Eigen::Vector2d cb = segs[static_cast<std::size_t>(q.seg)].centroid;
+      const Eigen::Vector2d ab = cb - ca;
+      const double dist = ab.norm();
+      if (dist > gap || dist <= 0.0) continue;
+      const Eigen::Vector2d ray = (0.5 * (ca + cb) - sensor_xy).normalized();
+      if (std::abs(ray.x() * ab.y() - ray.y() * ab.x()) > sin_max * dist) continue;
+      pairs.push_back({dist, pieces[i].seg, q.seg});
+    }
+  }
+  if (pairs.empty()) return 0;
+  std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
+    return a.dist < b.dist || (a.dist == b.dist && (a.a < b.a || (a.a == b.a && a.b < b.b)));
+  });
+  // Union-find over segments with the bounding box of each set at its root.
+  std::vector<std::int32_t> parent(segs.size());
+  for (std::size_t k = 0; k < segs.size(); ++k) parent[k] = static_cast<std::int32_t>(k);
+  std::vector<Eigen::Vector2d> lo(segs.size()), hi(segs.size());
+  for (std::size_t k = 0; k < segs.size(); ++k) {
+    lo[k] = segs[k].min;
+    hi[k] = segs[k].max;
+  }
+  auto find = [&](std::int32_t k) {
+    while (parent[static_cast<std::size_t>(k)] != k) {
+      parent[static_cast<std::size_t>(k)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(k)])];
+      k = parent[static_cast<std::size_t>(k)];
+    }
+    return k;
+  };
+  int joins = 0;
+  for (const Pair& pr : pairs) {
+    std::int32_t a = find(pr.a), b = find(pr.b);
+    if (a == b) continue;
+    const Eigen::Vector2d l = lo[static_cast<std::size_t>(a)].cwiseMin(lo[static_cast<std::size_t>(b)]);
+    const Eigen::Vector2d h = hi[static_cast<std::size_t>(a)].cwiseMax(hi[static_cast<std::size_t>(b)]);
+    if ((h - l).norm() > params.join_max_extent) continue;
+    if (b < a) std::swap(a, b);
+    parent[static_cast<std::size_t>(b)] = a;  // the lowest segment index is the root
+    lo[static_cast<std::size_t>(a)] = l;
+    hi[static_cast<std::size_t>(a)] = h;
+    ++joins;
+  }
+  if (joins == 0) return 0;
+  // Rebuild: each root segment followed by the returns of the segments joined to it.
+  std::vector<std::vector<std::int32_t>> members(segs.size());
+  for (std::size_t k = 0; k < segs.size(); ++k) {
+    members[static_cast<std::size_t>(find(static_cast<std::int32_t>(k)))].push_back(static_cast<std::int32_t>(k));
+  }
+  std::vector<std::int32_t> point;
+  point.reserve(segments->point.size());
+  std::vector<Segment> out;
+  out.reserve(segs.size());
+  for (std::size_t k = 0; k < segs.size(); ++k) {
+    if (members[k].empty()) continue;  // joined to another root
+    Segment g;
+    g.begin = static_cast<std::int32_t>(point.size());
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    for (const std::int32_t m : members[k]) {
+      const Segment& src = segs[static_cast<std::size_t>(m)];
+      for (std::int32_t i = src.begin; i < src.end; ++i) {
+        const std::int32_t p = segments->point[static_cast<std::size_t>(i)];
+        point.push_back(p);
+        sum += Eigen::Vector2d(pts.x[static_cast<std::size_t>(p)], pts.y[static_cast<std::size_t>(p)]);
+      }
+    }
+    g.end = static_cast<std::int32_t>(point.size());
+    g.min = lo[k];
+    g.max = hi[k];
+    g.centroid = sum / static_cast<double>(g.size());
+    out.push_back(g);
+  }
+  segments->point.swap(point);
+  segs.swap(out);
+  return joins;
 }
 
 std::vector<int> SolveAssignment(const std::vector<double>& cost, int rows, int cols) {

@@ -51,6 +51,13 @@ struct AssociationParams {
   double ignore_max_extent = 1.0;    // [m] smaller leftovers inside a gate are ignored
   int split_min_points = 3;          // [-] each part of a split segment has at least this many
   double min_slant_deg = 10.0;       // [deg] s in Eq. 15
+  // Pieces of a face seen at a grazing angle (JoinGrazingPieces): segments smaller than
+  // join_max_piece whose centroids lie within join_max_gap of each other along a line within
+  // join_max_deg of the ray are one segment, as long as it stays within join_max_extent.
+  double join_max_piece = 1.0;       // [m] bounding-box diagonal of a piece (0: no joining)
+  double join_max_gap = 2.5;         // [m] centroid distance of two pieces
+  double join_max_deg = 10.0;        // [deg] angle between the line of two pieces and the ray
+  double join_max_extent = 5.0;      // [m] bounding-box diagonal of the joined segment
 
   // True if every field is valid; otherwise false and *error names the key and its value.
   bool Validate(std::string* error) const;
@@ -87,6 +94,21 @@ struct AssociationResult {
 // with potentials, O(rows^2 cols). Hand-written: the core depends on Eigen only, and the
 // assignment is 60 lines that a brute-force test checks.
 std::vector<int> SolveAssignment(const std::vector<double>& cost, int rows, int cols);
+
+// Joins the pieces of faces seen at a grazing angle into one segment each (before association).
+// A 3-D scanner passing a parked row sees each car's side at a few degrees of incidence: one
+// column of returns per azimuth step, metres apart along the face (spacing ~ range^2 * step /
+// lateral offset: 1.4 m at 28 m for a 0.2 deg step and 2 m offset), each its own grid segment.
+// Tracked one by one they slide with the ego (a column stays at its bearing) and re-spawn as
+// new tracks. Two pieces (bounding-box diagonal < join_max_piece) are joined if their centroids
+// are within join_max_gap and the line between them is within join_max_deg of the ray to their
+// midpoint (a face seen nearly edge-on: a face seen at a larger slant is dense enough to be one
+// grid segment already); joins are made nearest first and refused if the joined bounding box
+// would exceed join_max_extent (cars of a row are 3 m apart and 4.5 m long: no chains). The
+// joined segment replaces the first piece, the others are removed; returns keep their order.
+// Returns the number of joins.
+int JoinGrazingPieces(const WorldPoints& pts, const Eigen::Vector2d& sensor_xy,
+                      const AssociationParams& params, Segments* segments);
 
 class Associator {
  public:

@@ -139,6 +139,13 @@ bool TrackManagerParams::Validate(std::string* error) const {
              "contour_support_height", p.contour_support_height, "m", "in [0, 2]", error) ||
       !Check(p.contour_support_range > 0 && p.contour_support_range <= 2, "contour_support_range",
              p.contour_support_range, "m", "in (0, 2]", error) ||
+      !Check(p.outline_min_slant_deg >= 0 && p.outline_min_slant_deg < 45,
+             "outline_min_slant_deg", p.outline_min_slant_deg, "deg", "in [0, 45)", error) ||
+      !Check(p.outline_min_points >= 3, "outline_min_points", p.outline_min_points, "", ">= 3",
+             error) ||
+      !Check(p.outline_min_edge_inliers >= 3 && p.outline_min_edge_inliers <= p.outline_min_points,
+             "outline_min_edge_inliers", p.outline_min_edge_inliers, "",
+             "in [3, outline_min_points]", error) ||
       !Check(p.default_length > 0 && p.default_length <= 30, "default_length", p.default_length,
              "m", "in (0, 30]", error) ||
       !Check(p.default_width > 0 && p.default_width <= 10, "default_width", p.default_width, "m",
@@ -179,7 +186,17 @@ double TrackHypothesis::Score() const {
 
 TrackManager::TrackManager(const TrackManagerParams& params, const Ekf& ekf,
                            const FitParams& fit, const ShapeParams& shape)
-    : params_(params), ekf_(ekf), fitter_(fit), shape_params_(shape) {
+    : params_(params),
+      ekf_(ekf),
+      fitter_(fit),
+      outline_fitter_([&] {
+        FitParams f = fit;
+        f.min_slant_deg = params.outline_min_slant_deg;
+        f.min_points = params.outline_min_points;
+        f.min_edge_inliers = params.outline_min_edge_inliers;
+        return f;
+      }()),
+      shape_params_(shape) {
   std::string error;
   if (!params_.Validate(&error)) throw std::invalid_argument(error);
   if (!shape_params_.Validate(&error)) throw std::invalid_argument(error);
@@ -273,7 +290,7 @@ bool TrackManager::Measure(const Track& t, TrackHypothesis* h, const PointSet& p
   req.range_sigma_m = params_.range_sigma;
   req.min_inside_fraction = h->inside_fraction;
   req.seed = seed;
-  fitter_.Fit(req, &h->fit);
+  (points.outline ? outline_fitter_ : fitter_).Fit(req, &h->fit);
   if (h->fit.kind == FitKind::kNone) return false;
   h->has_fit = true;
   m->z << h->fit.z.head<2>() + points.origin, h->fit.z(2);

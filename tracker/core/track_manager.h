@@ -110,6 +110,15 @@ struct TrackManagerParams {
   // (it stands on a vertical face; roofs and bonnets are grazed by single rings). 0: off.
   double contour_support_height = 0.1;      // [m]
   double contour_support_range = 0.25;      // [m]
+  // 3-D clouds: the fit on that outline refuses faces seen at less than outline_min_slant_deg
+  // and needs outline_min_points points and outline_min_edge_inliers on an edge (the fit's own
+  // min_slant_deg, min_points and min_edge_inliers apply to single-plane scans). Each outline
+  // point stands on a vertical face, corroborated by other rings: a face seen nearly edge-on
+  // (a parked car's side passed 2 m away: 3-6 deg at 20-40 m) gives one such point per azimuth
+  // step, 1-2.5 m apart, and is all of that car in view.
+  double outline_min_slant_deg = 2.0;       // [deg]
+  int outline_min_points = 3;               // [-]
+  int outline_min_edge_inliers = 3;         // [-]
   double default_length = 4.5;              // [m] rectangle of a new object before any estimate
   double default_width = 1.8;               // [m]
   double default_dimension_std = 1.0;       // [m] spread of that default
@@ -222,6 +231,7 @@ struct PointSet {
   std::int64_t mean_utime = 0;                       // [us] mean measurement time of the returns
   double extent = 0.0;                               // [m] bounding-box diagonal
   std::size_t size() const { return x.size(); }
+  bool outline = false;  // the outline of a 3-D cloud (TrackManagerParams::outline_*)
 };
 
 // The nearest return per bearing bin around the sensor, over every return of a scan. It tells
@@ -294,6 +304,7 @@ class TrackManager {
   TrackManagerParams params_;
   const Ekf& ekf_;
   SegmentFitter fitter_;
+  SegmentFitter outline_fitter_;  // fitter_'s parameters with the outline_* overrides
   ShapeParams shape_params_;
   double mover_d2_ = 0.0, mover_d1_ = 0.0;
   std::vector<Track> tracks_;

@@ -105,17 +105,6 @@ bool Tracker::CheckTime(std::int64_t utime, const char* what) {
     have_time_ = true;
     return true;
   }
-  // A jump forward longer than any track may coast (a clock step, a log that skips ahead): no
-  // track can survive it, and predicting them across it would only let stale tracks (with huge
-  // covariances) catch the new returns.
-  const std::int64_t forward_us = std::max(params_.input.time_jump_reset_us,
-                                           static_cast<std::int64_t>(params_.manager.coast_max_s * 1e6));
-  if (have_time_ && utime > latest_utime_ + forward_us) {
-    Reset(std::string(what) + " time jumped forward by " + Str((utime - latest_utime_) / 1000) + " ms");
-    latest_utime_ = utime;
-    have_time_ = true;
-    return true;
-  }
   if (!have_time_ || utime > latest_utime_) latest_utime_ = utime;
   have_time_ = true;
   return false;
@@ -134,6 +123,17 @@ void Tracker::AddPose(const EgoPose& pose, std::vector<ScanOutput>* out) {
     case PoseHistory::AddResult::kOk: break;
     case PoseHistory::AddResult::kDuplicate:
       Reject("pose_repeated", 1, "pose at " + Str(pose.utime) + " repeats the previous time");
+      return;
+    case PoseHistory::AddResult::kOutOfOrder:
+      Reject("pose_out_of_order", 1,
+             "pose at " + Str(pose.utime) + " is older than " + Str(poses_.newest_utime()));
+      return;
+  }
+  ProcessReady(false, out);
+}
+
+void Tracker::AddScan(LadarScan&& scan, std::vector<ScanOutput>* out) {
+  ++scans_received_;
   // Scans lost on the way (LCM drops a datagram, or a fragmented message with a fragment
   // missing, without a word) show as gaps in the sensor's seq: counted as "scan_seq_gap", one per
   // missing scan. A jump of more than kMaxSeqGap is a renumbered sensor, not loss.
@@ -147,26 +147,11 @@ void Tracker::AddPose(const EgoPose& pose, std::vector<ScanOutput>* out) {
   }
   if (!have_seq_ || scan.seq > last_seq_) last_seq_ = scan.seq;
   have_seq_ = true;
-      return;
-    case PoseHistory::AddResult::kOutOfOrder:
-      Reject("pose_out_of_order", 1,
-             "pose at " + Str(pose.utime) + " is older than " + Str(poses_.newest_utime()));
-      return;
-  }
-  ProcessReady(false, out);
-}
-
-void Tracker::AddScan(LadarScan&& scan, std::vector<ScanOutput>* out) {
-  ++scans_received_;
   const std::size_t n = scan.x.size();
   auto drop = [&](const char* reason, const std::string& msg) {
     ++scans_dropped_;
     Reject(reason, 1, "scan " + Str(scan.seq) + " at " + Str(scan.utime) + ": " + msg);
   };
-  const Eigen::Matrix3d mount = scan.body_from_sensor.linear();
-  if ((mount.transpose() * mount - Eigen::Matrix3d::Identity()).norm() > 1e-3) {
-    return drop("bad_scan", "mounting orientation is not a rotation");
-  }
   if (scan.y.size() != n || scan.z.size() != n ||
       (!scan.dt_us.empty() && scan.dt_us.size() != n) ||
       (!scan.ring.empty() && scan.ring.size() != n)) {
@@ -177,6 +162,10 @@ void Tracker::AddScan(LadarScan&& scan, std::vector<ScanOutput>* out) {
   }
   if (!scan.body_from_sensor.matrix().allFinite()) {
     return drop("bad_scan", "mounting pose is not finite");
+  }
+  const Eigen::Matrix3d mount = scan.body_from_sensor.linear();
+  if ((mount.transpose() * mount - Eigen::Matrix3d::Identity()).norm() > 1e-3) {
+    return drop("bad_scan", "mounting orientation is not a rotation");
   }
   if (n == 0) return drop("empty_scan", "no returns");
   if (static_cast<std::int64_t>(n) > params_.preprocess.max_points) {
@@ -241,6 +230,7 @@ bool Tracker::Process(const LadarScan& scan, bool forced, ScanOutput* out) {
   out->stats = pre.stats;
 
   segmenter_.Run(points_, scan.num_rings <= 1, pre.sensor_xy, &segments_);
+  JoinGrazingPieces(points_, pre.sensor_xy, params_.association, &segments_);
   const std::int64_t mid = scan.utime + scan.sweep_duration_us / 2;
   manager_->Predict(mid, &predicted_);
   associator_.Run(predicted_, points_, segments_, pre.sensor_xy, &association_);
@@ -267,6 +257,7 @@ bool Tracker::Process(const LadarScan& scan, bool forced, ScanOutput* out) {
       if (has_dt) dt_sum += scan.dt_us[static_cast<std::size_t>(points_.index[i])];
     }
     ps.extent = (hi - lo).norm();
+    ps.outline = multi_ring && params_.manager.fit_contour_deg > 0.0;
     ps.mean_utime = scan.utime + static_cast<std::int64_t>(std::llround(dt_sum / idx.size()));
     // The outline the sensor sees: per bearing bin (fit_contour_deg, seen from the sensor) the
     // nearest return. A 3-D cloud also holds roofs, windows and returns stacked in columns;

@@ -8,8 +8,10 @@
 #include <algorithm>
 #include <numeric>
 #include <random>
+#include <set>
 
 #include "tracker/core/angle.h"
+#include "tracker/core/segmentation.h"
 
 namespace vtrack {
 namespace {
@@ -174,6 +176,133 @@ TEST(AssociatorTest, PrefersReturnsOnTheVisibleFaces) {
   EXPECT_LT(res.track_cost[0], 0.05);
 }
 
+// First hit of the ray from `sensor` at bearing `b` on the faces of `boxes`: the box index, or
+// -1; *hit is the point. Ray against each face segment (independent of the code under test).
+int CastRay(const std::vector<OrientedBox>& boxes, const Eigen::Vector2d& sensor, double b,
+            Eigen::Vector2d* hit) {
+  const Eigen::Vector2d d(std::cos(b), std::sin(b));
+  double best = 1e300;
+  int which = -1;
+  for (std::size_t k = 0; k < boxes.size(); ++k) {
+    for (int f = 0; f < 4; ++f) {
+      Eigen::Vector2d a, c;
+      boxes[k].FaceEndpoints(static_cast<Face>(f), &a, &c);
+      const Eigen::Vector2d e = c - a;
+      const double den = d.x() * e.y() - d.y() * e.x();
+      if (std::abs(den) < 1e-12) continue;
+      const Eigen::Vector2d w = a - sensor;
+      const double t = (w.x() * e.y() - w.y() * e.x()) / den;  // along the ray
+      const double u = (w.x() * d.y() - w.y() * d.x()) / den;  // along the face
+      if (t > 0.0 && u >= 0.0 && u <= 1.0 && t < best) {
+        best = t;
+        which = static_cast<int>(k);
+      }
+    }
+  }
+  *hit = sensor + best * d;
+  return which;
+}
+
+// A 3-D scanner (0.176 deg azimuth steps, 5 rings on each face) passing a parked row 2 m to
+// its side: each car's side is seen at 3-6 deg, one column of returns per step, metres apart.
+struct RowScene {
+  WorldPoints pts;
+  std::vector<int> car;  // per return: index of the car hit
+  Segments segments;
+};
+
+RowScene ParkedRow(const Eigen::Vector2d& sensor) {
+  std::vector<OrientedBox> cars;
+  for (int k = 0; k < 4; ++k) cars.push_back({{2.85, 18.0 + 7.5 * k}, kPi / 2, 4.5, 1.8});
+  RowScene s;
+  const double step = DegToRad(360.0 / 2048.0);
+  for (double b = DegToRad(60.0); b < DegToRad(89.0); b += step) {
+    Eigen::Vector2d hit;
+    const int k = CastRay(cars, sensor, b, &hit);
+    if (k < 0) continue;
+    for (int ring = 0; ring < 5; ++ring) {
+      s.pts.push_back(hit.x(), hit.y(), 0.3f + 0.25f * static_cast<float>(ring),
+                      static_cast<std::int32_t>(s.pts.size()), static_cast<std::int16_t>(ring));
+      s.car.push_back(k);
+    }
+  }
+  SegmentationParams sp;
+  Segmenter(sp).Run(s.pts, /*scan_line=*/false, sensor, &s.segments);
+  return s;
+}
+
+// Cars of each segment, and segments of each car.
+void Tally(const RowScene& s, std::vector<std::set<int>>* cars_of_segment,
+           std::vector<std::set<int>>* segments_of_car) {
+  cars_of_segment->assign(s.segments.segments.size(), {});
+  segments_of_car->assign(4, {});
+  for (std::size_t g = 0; g < s.segments.segments.size(); ++g) {
+    const Segment& seg = s.segments.segments[g];
+    for (std::int32_t i = seg.begin; i < seg.end; ++i) {
+      const int k = s.car[static_cast<std::size_t>(s.segments.point[static_cast<std::size_t>(i)])];
+      (*cars_of_segment)[g].insert(k);
+      (*segments_of_car)[static_cast<std::size_t>(k)].insert(static_cast<int>(g));
+    }
+  }
+}
+
+TEST(JoinGrazingPiecesTest, ColumnsOfEachParkedCarBecomeOneSegmentWithoutChainingCars) {
+  const Eigen::Vector2d sensor(0, 0);
+  RowScene s = ParkedRow(sensor);
+  std::vector<std::set<int>> cars_of_segment, segments_of_car;
+  Tally(s, &cars_of_segment, &segments_of_car);
+  // Without joining, the cars 23-38 m away fall apart into columns.
+  for (int k = 1; k < 3; ++k) EXPECT_GE(segments_of_car[static_cast<std::size_t>(k)].size(), 3u) << "car " << k;
+  const std::size_t returns = s.segments.point.size();
+  const int joins = JoinGrazingPieces(s.pts, sensor, AssociationParams{}, &s.segments);
+  EXPECT_GT(joins, 0);
+  EXPECT_EQ(s.segments.point.size(), returns);  // no return lost or duplicated
+  Tally(s, &cars_of_segment, &segments_of_car);
+  for (std::size_t g = 0; g < cars_of_segment.size(); ++g) {
+    EXPECT_EQ(cars_of_segment[g].size(), 1u) << "segment " << g << " holds returns of several cars";
+    const Segment& seg = s.segments.segments[g];
+    Eigen::Vector2d lo = Eigen::Vector2d::Constant(1e300), hi = -lo, sum = Eigen::Vector2d::Zero();
+    for (std::int32_t i = seg.begin; i < seg.end; ++i) {
+      const auto p = static_cast<std::size_t>(s.segments.point[static_cast<std::size_t>(i)]);
+      const Eigen::Vector2d q(s.pts.x[p], s.pts.y[p]);
+      lo = lo.cwiseMin(q);
+      hi = hi.cwiseMax(q);
+      sum += q;
+    }
+    EXPECT_NEAR((seg.min - lo).norm() + (seg.max - hi).norm(), 0.0, 1e-9);
+    EXPECT_NEAR((seg.centroid - sum / seg.size()).norm(), 0.0, 1e-9);
+  }
+  // The nearest car's rear face and first metre of side are one dense segment (larger than a
+  // piece: not joined; association absorbs columns on a track's rectangle), its columns another.
+  EXPECT_EQ(segments_of_car[0].size(), 2u);
+  for (int k = 1; k < 4; ++k) {
+    EXPECT_EQ(segments_of_car[static_cast<std::size_t>(k)].size(), 1u) << "car " << k;
+  }
+}
+
+TEST(JoinGrazingPiecesTest, PiecesSideBySideAcrossTheRayOrTooFarApartStaySeparate) {
+  const Eigen::Vector2d sensor(0, 0);
+  WorldPoints pts;
+  // Two poles 1.5 m apart across the ray at 20 m, and two columns 4 m apart along it.
+  for (const Eigen::Vector2d& c : {Eigen::Vector2d(20.0, -0.75), Eigen::Vector2d(20.0, 0.75),
+                                  Eigen::Vector2d(0.5, 30.0), Eigen::Vector2d(0.6, 34.0)}) {
+    for (int i = 0; i < 4; ++i) {
+      pts.push_back(c.x() + 0.05 * (i % 2), c.y() + 0.05 * (i / 2), 1.0f, static_cast<std::int32_t>(pts.size()), 0);
+    }
+  }
+  Segments segs = SegmentsOf(pts, {{0, 4}, {4, 8}, {8, 12}, {12, 16}});
+  for (auto& g : segs.segments) g.centroid = 0.5 * (g.min + g.max);
+  EXPECT_EQ(JoinGrazingPieces(pts, sensor, AssociationParams{}, &segs), 0);
+  EXPECT_EQ(segs.segments.size(), 4u);
+  // Joining off: nothing changes even for the parked row.
+  RowScene s = ParkedRow(sensor);
+  const std::size_t n = s.segments.segments.size();
+  AssociationParams off;
+  off.join_max_piece = 0.0;
+  EXPECT_EQ(JoinGrazingPieces(s.pts, sensor, off, &s.segments), 0);
+  EXPECT_EQ(s.segments.segments.size(), n);
+}
+
 TEST(AssociatorTest, ValidateNamesTheKey) {
   AssociationParams p;
   std::string error;
@@ -181,6 +310,10 @@ TEST(AssociatorTest, ValidateNamesTheKey) {
   p.min_inside_fraction = 0.0;
   EXPECT_FALSE(p.Validate(&error));
   EXPECT_NE(error.find("min_inside_fraction = 0"), std::string::npos);
+  p = AssociationParams{};
+  p.join_max_gap = -1.0;
+  EXPECT_FALSE(p.Validate(&error));
+  EXPECT_NE(error.find("join_max_gap = -1"), std::string::npos) << error;
 }
 
 }  // namespace

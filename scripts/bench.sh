@@ -1,20 +1,21 @@
 #!/usr/bin/env bash
 # Runs the tracker benchmarks of issue 9 and prints one table; writes the figures as JSON.
 #
-#   scripts/bench.sh BUILD_DIR [--json F] [--all] [--soak-minutes M] [--e2e-scans N]
+#   scripts/bench.sh BUILD_DIR [--json F] [--all] [--soak-minutes M] [--e2e-scans N] [--report-only]
 #
 #   BUILD_DIR          a Release build with the benchmarks (./vtrack.sh bench makes it)
 #   --json F           where to write the figures (default: ./bench-results.json)
 #   --all              also run the other benchmark programs (kitti, sim, eval, render)
 #   --soak-minutes M   simulated length of the memory soak (default 10)
 #   --e2e-scans N      scans published in the live latency run (default 150)
+#   --report-only      run nothing: the table and JSON from the raw outputs of the last run
 #
 # Raw outputs (Google Benchmark JSON, logs) go to BUILD_DIR/bench-out/. Needs jq.
 # A figure that cannot be measured here is null in the JSON, with the reason under "notes".
 set -euo pipefail
 
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-usage() { sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; }
 
 [ $# -ge 1 ] || { usage; exit 2; }
 case "$1" in -h|--help) usage; exit 0 ;; esac
@@ -24,12 +25,14 @@ json_out=$PWD/bench-results.json
 all=0
 soak_minutes=10
 e2e_scans=150
+report_only=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --json) [ $# -ge 2 ] || { echo "bench.sh: --json needs a file" >&2; exit 2; }; json_out=$2; shift 2 ;;
     --all) all=1; shift ;;
     --soak-minutes) soak_minutes=${2:?}; shift 2 ;;
     --e2e-scans) e2e_scans=${2:?}; shift 2 ;;
+    --report-only) report_only=1; shift ;;
     -h|--help) usage; exit 0 ;;
     *) echo "bench.sh: unknown option '$1'" >&2; usage >&2; exit 2 ;;
   esac
@@ -60,6 +63,7 @@ run_gbench() {
   log "  done in $((SECONDS - start)) s"
 }
 
+if [ $report_only = 0 ]; then
 rm -f "$out"/*.json
 run_gbench tracker_bench
 run_gbench stages_bench
@@ -102,6 +106,12 @@ if [ -x "$bench/tracker_soak" ]; then
 else
   notes+=("tracker_soak not built")
 fi
+fi  # report_only
+if [ $report_only = 1 ]; then
+  for f in tracker_bench stages_bench models_bench fitting_bench pcl_bench e2e soak; do
+    [ -s "$out/$f.json" ] || notes+=("no $f output in $out (not built, skipped or failed: see its .log)")
+  done
+fi
 
 # ---- aggregate -------------------------------------------------------------------------------
 gb() {  # gb FILE: the benchmarks array of a Google Benchmark JSON, [] if missing
@@ -117,19 +127,20 @@ jq -n \
   --argjson notes "$notes_json" --arg host "$(uname -n)" --arg cpu "$(nproc) cores" \
   --arg commit "$(git -C "$here" rev-parse --short HEAD 2>/dev/null || echo unknown)" '
   def bm($arr; $prefix): [$arr[] | select(.name | startswith($prefix))] | first;
+  # CPU time per iteration in ms; for the manual-time benchmarks the manual time (thread CPU time).
   def ms($b): if $b == null then null
-              else ($b.real_time * (if $b.time_unit == "ns" then 1e-6 elif $b.time_unit == "us" then 1e-3
-                                    elif $b.time_unit == "s" then 1e3 else 1 end)) end;
+              else ((if ($b.name | test("manual_time")) then $b.real_time else $b.cpu_time end)
+                    * (if $b.time_unit == "ns" then 1e-6 elif $b.time_unit == "us" then 1e-3
+                       elif $b.time_unit == "s" then 1e3 else 1 end)) end;
   def slope($pts): if ($pts | length) < 2 then null else
       ($pts | map(.[0]) | add / length) as $mx | ($pts | map(.[1]) | add / length) as $my |
       (($pts | map((.[0] - $mx) * (.[1] - $my)) | add) / ($pts | map((.[0] - $mx) * (.[0] - $mx)) | add)) end;
-  def scaling($prefix; $x):
+  def scaling($prefix):
       [$tb[] | select(.name | startswith($prefix)) | select(.error_occurred != true)
-       | {n: ($x(.)), ms: .median_ms}];
+       | {n: (.name | split("/")[1] | tonumber), ms: .median_ms}];
   bm($tb; "BM_TrackerScan_Kitti") as $k | bm($tb; "BM_TrackerScan_Stress") as $s |
   bm($tb; "BM_TrackerScan_Fig4") as $f | bm($tb; "BM_CopyFloor_Kitti") as $c |
-  scaling("BM_PointsScaling/"; (.name | split("/")[1] | tonumber)) as $pts |
-  scaling("BM_ObjectsScaling/"; (.name | split("/")[1] | tonumber)) as $objs |
+  scaling("BM_PointsScaling/") as $pts | scaling("BM_ObjectsScaling/") as $objs |
   bm($pb; "BM_Segmentation_Grid") as $grid | bm($pb; "BM_Segmentation_PclEuclidean") as $pcl |
   {
     commit: $commit, host: $host, cpu: $cpu,
@@ -154,6 +165,7 @@ jq -n \
     pcl_adjusted_rand_index: $pcl.adjusted_rand, pcl_segments_matched: $pcl.segments_matched,
     e2e_latency_ms_median: $e2e.e2e_latency_ms_median, e2e_latency_ms_p99: $e2e.e2e_latency_ms_p99,
     e2e_latency_ms_max: $e2e.e2e_latency_ms_max, e2e_lost: $e2e.e2e_lost,
+    e2e_tracker_ms_median: $e2e.e2e_tracker_ms_median, e2e_tracker_ms_p99: $e2e.e2e_tracker_ms_p99,
     rss_growth_pct: $soak.rss_growth_pct, rss_start_mb: $soak.rss_start_mb,
     rss_end_mb: $soak.rss_end_mb, rss_peak_mb: $soak.rss_peak_mb,
     heap_start_mb: $soak.heap_start_mb, heap_end_mb: $soak.heap_end_mb, heap_peak_mb: $soak.heap_peak_mb,
@@ -188,6 +200,7 @@ jq -r '
   ["PCL Euclidean / grid segmentation time", f(.pcl_cluster_speed_ratio; 1), "> 1", ok(if .pcl_cluster_speed_ratio == null then null else .pcl_cluster_speed_ratio > 1 end)],
   ["  PCL ms / grid ms; adjusted Rand; segments matched", "\(f(.pcl_cluster_ms; 2)) / \(f(.grid_cluster_ms; 2)); \(f(.pcl_adjusted_rand_index; 3)); \(f(.pcl_segments_matched; 3))", "", ""],
   ["e2e latency ms median / p99 (LCM, 10 Hz, KITTI)", "\(f(.e2e_latency_ms_median; 2)) / \(f(.e2e_latency_ms_p99; 2))", "p99 < 20", ok(lt(.e2e_latency_ms_p99; 20))],
+  ["  of which in the tracker (callback to publish) median / p99", "\(f(.e2e_tracker_ms_median; 2)) / \(f(.e2e_tracker_ms_p99; 2))", "", ""],
   ["RSS MB start / end / peak (10 min stress)", "\(f(.rss_start_mb; 1)) / \(f(.rss_end_mb; 1)) / \(f(.rss_peak_mb; 1))", "", ""],
   ["RSS growth %", f(.rss_growth_pct; 2), "~0", ok(if .rss_growth_pct == null then null else .rss_growth_pct < 2 end)],
   (.stages_ms | to_entries[] | ["stage: \(.key) ms", f(.value; 3), "", ""]),

@@ -188,7 +188,17 @@ TEST(TrackerLiveTest, UrbanIntersectionLiveWith64LayerScans) {
   // Live and offline: the same tracks when nothing is lost on the bus.
   const EvalResult off = EvaluateTracks(run.sim_log, run.offline);
   std::printf("offline urban_intersection (12 s): %s\n", Summary(off).c_str());
-  if (st.scans_processed == LastStatus(run.offline).scans_processed) {
+  // A scan whose poses came late (a loaded machine) is compensated with an extrapolated pose:
+  // then its returns, and the tracks, differ slightly from the offline run.
+  std::int64_t extrapolated = 0;
+  for (int i = 0; i < st.num_reasons; ++i) {
+    std::printf("  live reject %s: %lld\n", st.reject_reason[static_cast<std::size_t>(i)].c_str(),
+                static_cast<long long>(st.reject_count[static_cast<std::size_t>(i)]));
+    if (st.reject_reason[static_cast<std::size_t>(i)] == "pose_extrapolated") {
+      extrapolated = st.reject_count[static_cast<std::size_t>(i)];
+    }
+  }
+  if (st.scans_processed == LastStatus(run.offline).scans_processed && extrapolated == 0) {
     EXPECT_GT(CompareTracks(TracksByUtime(run.live_log), TracksByUtime(run.offline), 1e-9), 100);
   }
   std::filesystem::remove(run.sim_log);

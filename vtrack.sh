@@ -2,7 +2,7 @@
 # vtrack: the one entry point. Installs what is missing (Debian 12 packages), builds, and runs.
 #
 #   ./vtrack.sh demo [DEMO OPTIONS]   the main job (see ./vtrack.sh demo --help)
-#   ./vtrack.sh test [CTEST ARGS]     every test (what CI runs)
+#   ./vtrack.sh test [CTEST ARGS]     every test, then again under ASan+UBSan, + short fuzzing (CI)
 #   ./vtrack.sh bench [--json F]      the benchmarks: one table + bench-results.json
 #   ./vtrack.sh fuzz [SECONDS]        build the libFuzzer harnesses (clang) and run each SECONDS (60)
 #   ./vtrack.sh build                 set up and build only
@@ -22,7 +22,7 @@ pkgs_build=(g++ make cmake pkg-config
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev
   libgtest-dev libbenchmark-dev default-jdk-headless)
 pkgs_run=(iproute2 procps zstd tar)
-pkgs_test=(xvfb xauth default-jre libjchart2d-java)
+pkgs_test=(xvfb xauth default-jre libjchart2d-java nftables)
 pkgs_bench=(jq)
 pkgs_bench_optional=(libpcl-dev)  # the peer of pcl_bench; without it that comparison is skipped
 pkgs_fuzz=(clang libclang-rt-14-dev)
@@ -63,6 +63,29 @@ configure_and_build() {
   cmake --build "$build_dir" -j "$jobs"
 }
 
+# The whole suite again under AddressSanitizer + UndefinedBehaviorSanitizer, built with clang
+# (whose UBSan also checks float-to-int overflow), -O1 with line tables and asserts on, no
+# benchmarks (nothing they test that the tests do not), in its own tree; then a short smoke run
+# of every libFuzzer harness from the same tree (coverage from the harness files only: compiling
+# the libraries with coverage would cost more than the run; ./vtrack.sh fuzz has it all).
+# VTRACK_TEST_SANITIZERS=0 skips all of it.
+sanitizer_tests() {
+  local sdir=${VTRACK_SANITIZE_BUILD_DIR:-$build_dir-asan} start
+  log "building with ASan + UBSan (clang) in $sdir with $jobs jobs"
+  CC=clang CXX=clang++ cmake -S "$here" -B "$sdir" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
+    -DVTRACK_SANITIZE=ON -DVTRACK_BUILD_FUZZERS=ON -DVTRACK_FUZZ_COVERAGE=OFF \
+    -DVTRACK_BUILD_BENCHMARKS=OFF >/dev/null
+  cmake --build "$sdir" -j "$jobs"
+  start=$(date +%s)
+  log "running every test under ASan + UBSan"
+  ctest --test-dir "$sdir" --output-on-failure -j "$jobs" "$@"
+  log "sanitizer tests passed in $(( $(date +%s) - start )) s"
+  log "fuzzing every harness for ${VTRACK_FUZZ_SECONDS:-10} s"
+  VTRACK_FUZZ_BUILD_DIR=$sdir "$here/scripts/fuzz.sh" "$here" "${VTRACK_FUZZ_SECONDS:-10}"
+}
+
 cmd=${1:-help}
 shift || true
 case "$cmd" in
@@ -74,12 +97,15 @@ case "$cmd" in
     install_packages "${pkgs_build[@]}" "${pkgs_run[@]}"
     configure_and_build Release ;;
   test)
-    install_packages "${pkgs_build[@]}" "${pkgs_run[@]}" "${pkgs_test[@]}"
+    install_packages "${pkgs_build[@]}" "${pkgs_run[@]}" "${pkgs_test[@]}" "${pkgs_fuzz[@]}"
+    t0=$(date +%s)
     configure_and_build Release
     start=$(date +%s)
     log "running every test (ctest)"
     ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" "$@"
-    log "tests passed in $(( $(date +%s) - start )) s" ;;
+    log "tests passed in $(( $(date +%s) - start )) s"
+    [ "${VTRACK_TEST_SANITIZERS:-1}" = 0 ] || sanitizer_tests "$@"
+    log "all done in $(( $(date +%s) - t0 )) s" ;;
   bench)
     # Options go to scripts/bench.sh: [--json F] [--all] [--soak-minutes M] [--e2e-scans N].
     install_packages "${pkgs_build[@]}" "${pkgs_run[@]}" "${pkgs_bench[@]}"

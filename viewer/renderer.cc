@@ -435,8 +435,10 @@ class LabelPlacer {
       vmin = std::min(vmin, p.y());
       vmax = std::max(vmax, p.y());
     }
-    // Far outside the image: nothing to label.
-    if (umax < -200.0 || umin > img_.cols + 200.0 || vmax < -200.0 || vmin > img_.rows + 200.0) {
+    // Far outside the image: nothing to label. Nor beside a rectangle far larger than the image
+    // (its label spots would not fit in an int: UB, found by clang's UBSan).
+    if (umax < -200.0 || umin > img_.cols + 200.0 || vmax < -200.0 || vmin > img_.rows + 200.0 ||
+        umax - umin > 1e6 || vmax - vmin > 1e6) {
       return false;
     }
     for (const std::string& text : texts) {

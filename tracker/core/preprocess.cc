@@ -235,10 +235,16 @@ void Preprocessor::RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts,
   const float* const ph = pts->height.data();
   std::int32_t* const pc = point_cell_.data();
   float* const cmin = cell_min_.data();
+  // Within max_range of the sensor, hence inside the grid (with one spare ring of cells) — unless
+  // the ego pose jumps within the sweep: clamped before the conversion to int (which would be
+  // undefined for a return 1e9 m away; found by tests/fuzz/tracker_fuzzer.cc), NaN to the edge.
+  const auto cell_index = [&](double offset) {
+    const double c = offset / cell;
+    return c >= 1.0 && c <= side - 2.0 ? static_cast<int>(c) : (c > side - 2.0 ? side - 2 : 1);
+  };
   for (std::size_t i = 0; i < n; ++i) {
-    // Within max_range of the sensor, hence inside the grid (with one spare ring of cells).
-    const int cx = std::clamp(static_cast<int>((px[i] - x0) / cell), 1, side - 2);
-    const int cy = std::clamp(static_cast<int>((py[i] - y0) / cell), 1, side - 2);
+    const int cx = cell_index(px[i] - x0);
+    const int cy = cell_index(py[i] - y0);
     const std::int32_t c = cy * side + cx;
     pc[i] = c;
     cmin[c] = std::min(cmin[c], ph[i]);

@@ -126,7 +126,8 @@ jq -n \
   --argjson pb "$(gb pcl_bench)" --argjson e2e "$(side e2e)" --argjson soak "$(side soak)" \
   --argjson notes "$notes_json" --arg host "$(uname -n)" --arg cpu "$(nproc) cores" \
   --arg commit "$(git -C "$here" rev-parse --short HEAD 2>/dev/null || echo unknown)" '
-  def bm($arr; $prefix): [$arr[] | select(.name | startswith($prefix))] | first;
+  # first successful run of a benchmark (one that skipped with an error, e.g. no KITTI data, is absent)
+  def bm($arr; $prefix): [$arr[] | select(.name | startswith($prefix)) | select(.error_occurred != true)] | first;
   # CPU time per iteration in ms; for the manual-time benchmarks the manual time (thread CPU time).
   def ms($b): if $b == null then null
               else ((if ($b.name | test("manual_time")) then $b.real_time else $b.cpu_time end)

@@ -11,7 +11,15 @@ for f in lib/cmake/vtrack/vtrackConfig.cmake include/vtrack/track_t.hpp share/ja
          include/vtrack/tracker/core/box.h bin/vtrack-netns; do
   [ -e "$work/prefix/$f" ] || { echo "FAIL: not installed: $f"; exit 1; }
 done
-cmake -S "$consumer" -B "$work/build" -DCMAKE_PREFIX_PATH="$work/prefix" >"$work/configure.log" 2>&1 \
+# A sanitized build installs instrumented static libraries: a consumer links them with the same
+# compiler (its sanitizer runtime) and the same -fsanitize link flags.
+extra=()
+cache_get() { sed -n "s/^$1:[A-Z]*=//p" "$build/CMakeCache.txt"; }
+if [ "$(cache_get VTRACK_SANITIZE)" = ON ]; then
+  extra=(-DCMAKE_CXX_COMPILER="$(cache_get CMAKE_CXX_COMPILER)"
+         -DCMAKE_EXE_LINKER_FLAGS=-fsanitize=address,undefined)
+fi
+cmake -S "$consumer" -B "$work/build" -DCMAKE_PREFIX_PATH="$work/prefix" "${extra[@]}" >"$work/configure.log" 2>&1 \
   || { cat "$work/configure.log"; exit 1; }
 cmake --build "$work/build" -j2 >"$work/build.log" 2>&1 || { cat "$work/build.log"; exit 1; }
 "$work/build/consumer"

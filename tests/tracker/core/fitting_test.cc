@@ -571,17 +571,21 @@ TEST(Fitting, PredictionResolvesTheNinetyDegreeAmbiguity) {
 //    of z^2 above chi-square(1)'s 99 % quantile; checked <= 6 %.
 //  - without outliers: mean z^2 = 0.78 (the end model is conservative by about 20 % in
 //    variance, never overconfident): checked within [0.6, the upper 95 % chi-square bound].
-TEST(Fitting, NewObjectHeadingFromTheLongerEdge) {
-  std::mt19937 rng(71);
+// New-object fits of 200 random vehicles seen with both faces whole (slant >= 30 deg, shape
+// unknown, default size), with or without spurious returns. Checks the heading (longer extent =
+// length axis, theta in (-pi/2, pi/2], within 3 deg modulo 180) and that no extent is flagged
+// full; returns z^2 = (extent error / its stated std)^2 of both extents of every corner fit.
+std::vector<double> NewObjectExtentZ2(std::uint32_t seed, bool outliers) {
+  std::mt19937 rng(seed);
   FitParams params;
   params.surface_std_m = 0.0;
   SegmentFitter fitter(params);
   int checked = 0;
   std::vector<double> z2;
   for (int t = 0; t < 200; ++t) {
-    // Views where both faces are seen in full (slant >= 30 deg): the longer extent is the length.
     const OrientedBox truth = RandomVehicle(rng, 2, DegToRad(30.0));
     ScanSpec spec = RandomSpec(rng, truth, OutlierKind::kSpurious);
+    if (!outliers) spec.outlier_fraction = 0.0;
     const SyntheticScan scan = MakeScan(spec, rng);
     FitRequest req = RequestFor(scan, spec, t);
     req.shape_known = false;
@@ -594,15 +598,19 @@ TEST(Fitting, NewObjectHeadingFromTheLongerEdge) {
     ++checked;
     EXPECT_GT(fit.z.z(), -0.5 * kPi);
     EXPECT_LE(fit.z.z(), 0.5 * kPi);
-    // Heading modulo 180 deg.
     EXPECT_LT(std::abs(std::remainder(fit.z.z() - truth.theta, kPi)), DegToRad(3.0)) << t;
     EXPECT_FALSE(fit.length_full_view);
     EXPECT_FALSE(fit.width_full_view);
     z2.push_back(std::pow((fit.observed_length_m - truth.length) / fit.observed_length_std_m, 2));
     z2.push_back(std::pow((fit.observed_width_m - truth.width) / fit.observed_width_std_m, 2));
-    printf("DBG %d L %.3f %.3f W %.3f %.3f\n", t, fit.observed_length_m - truth.length, fit.observed_length_std_m, fit.observed_width_m - truth.width, fit.observed_width_std_m);
   }
   EXPECT_GE(checked, 190);
+  return z2;
+}
+
+TEST(Fitting, NewObjectHeadingFromTheLongerEdge) {
+  const std::vector<double> z2 = NewObjectExtentZ2(71, /*outliers=*/true);
+  ASSERT_FALSE(z2.empty());
   const boost::math::chi_squared chi2_1(1.0);
   const double q99 = boost::math::quantile(chi2_1, 0.99);
   const double above = std::count_if(z2.begin(), z2.end(), [&](double v) { return v > q99; });
@@ -616,27 +624,7 @@ TEST(Fitting, NewObjectHeadingFromTheLongerEdge) {
 }
 
 TEST(Fitting, NewObjectExtentStdWithoutOutliers) {
-  std::mt19937 rng(72);
-  FitParams params;
-  params.surface_std_m = 0.0;
-  SegmentFitter fitter(params);
-  std::vector<double> z2;
-  for (int t = 0; t < 200; ++t) {
-    const OrientedBox truth = RandomVehicle(rng, 2, DegToRad(30.0));
-    ScanSpec spec = RandomSpec(rng, truth, OutlierKind::kSpurious);
-    spec.outlier_fraction = 0.0;
-    const SyntheticScan scan = MakeScan(spec, rng);
-    FitRequest req = RequestFor(scan, spec, t);
-    req.shape_known = false;
-    req.length_m = 4.5;
-    req.width_m = 1.8;
-    req.length_std_m = 1.0;
-    req.width_std_m = 0.3;
-    const FitResult fit = fitter.Fit(req);
-    if (fit.kind != FitKind::kCorner) continue;
-    z2.push_back(std::pow((fit.observed_length_m - truth.length) / fit.observed_length_std_m, 2));
-    z2.push_back(std::pow((fit.observed_width_m - truth.width) / fit.observed_width_std_m, 2));
-  }
+  const std::vector<double> z2 = NewObjectExtentZ2(72, /*outliers=*/false);
   ASSERT_GE(z2.size(), 380u);
   double mean = 0.0;
   for (double v : z2) mean += v / z2.size();

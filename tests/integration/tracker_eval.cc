@@ -134,7 +134,11 @@ EvalResult EvaluateTracks(const std::string& truth_log, const std::string& track
       const bool due = fs != first_seen.end() &&
                        utime - fs->second >= static_cast<std::int64_t>(opt.in_view_delay_s * 1e6) &&
                        utime - ls->second <= static_cast<std::int64_t>(opt.occlusion_grace_s * 1e6);
-      if (due) ++res.due;
+      if (due) {
+        ++res.due;
+        ++res.vehicle_due[o.id];
+        if (!matched) ++res.vehicle_missed[o.id];
+      }
       if (!matched) {
         if (due && res.misses.size() < 20) {
           char buf[200];

@@ -48,6 +48,7 @@ struct EvalResult {
   std::map<std::int64_t, std::vector<std::int64_t>> ids;  // vehicle -> track ids in order
   std::map<std::int64_t, double> vehicle_pos_rmse;        // [m] per vehicle
   std::map<std::int64_t, double> vehicle_heading_rmse_deg;  // [deg] axis error per vehicle
+  std::map<std::int64_t, std::int64_t> vehicle_due, vehicle_missed;  // due pairs, and those missed
 };
 
 // truth_log: a log with GROUND_TRUTH and EGO_POSE (vtrack-sim-log). tracks_log: TRACKS.

@@ -23,6 +23,11 @@ int main(int argc, char** argv) {
     for (const auto& [id, ids] : r.ids) {
       std::printf("  vehicle %lld: tracks", static_cast<long long>(id));
       for (auto t : ids) std::printf(" %lld", static_cast<long long>(t));
+      if (r.vehicle_due.count(id)) {
+        std::printf("  (missed %lld of %lld due)",
+                    static_cast<long long>(r.vehicle_missed.count(id) ? r.vehicle_missed.at(id) : 0),
+                    static_cast<long long>(r.vehicle_due.at(id)));
+      }
       if (r.vehicle_pos_rmse.count(id)) {
         std::printf("  (pos RMSE %.2f m, heading RMSE %.1f deg)", r.vehicle_pos_rmse.at(id),
                     r.vehicle_heading_rmse_deg.at(id));

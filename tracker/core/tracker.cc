@@ -335,7 +335,8 @@ bool Tracker::Process(const LadarScan& scan, bool forced, ScanOutput* out) {
   // 3-D clouds only: a single-plane scanner's bearing spacing (0.5 deg or more) leaves bins of
   // the profile empty between its returns, which would read as free space beyond a face's end.
   if (multi_ring) {
-    profile_.Build(pre.sensor_xy, points_.x, points_.y, std::max(0.05, params_.manager.fit_contour_deg));
+    profile_.Build(pre.sensor_xy, points_.x, points_.y, points_.ring,
+                   std::max(0.05, params_.manager.fit_contour_deg));
   }
   const std::size_t num_tracks = manager_->tracks().size();
   for (std::size_t j = 0; j < num_tracks; ++j) {
@@ -354,11 +355,34 @@ bool Tracker::Process(const LadarScan& scan, bool forced, ScanOutput* out) {
                      debug_ ? &dbg : nullptr, multi_ring ? &profile_ : nullptr);
     if (debug_) out->debug.push_back(std::move(dbg));
   }
-  // New tracks, largest segments first; a segment mostly inside the rectangle of a track just
-  // created from this scan is part of that object (a face cut off by a range jump), not a new one.
+  // New tracks, rectangles before small objects, each group largest first; a segment mostly
+  // inside the rectangle of a track just created from this scan is part of that object (a face
+  // cut off by a range jump), not a new one. A car's end face seen edge-on at 30-40 m is a piece
+  // of a few returns beside its side, and may hold more returns than the side: created first,
+  // it became a second track of the car (measured by centroid, 2 m from the car's centre), which
+  // grew into a rectangle a few scans later and replaced the car's track (an identity switch).
   auto& objs = association_.new_objects;
-  std::stable_sort(objs.begin(), objs.end(),
-                   [](const auto& a, const auto& b) { return a.size() > b.size(); });
+  {
+    std::vector<std::pair<std::pair<bool, std::size_t>, std::size_t>> order(objs.size());
+    for (std::size_t k = 0; k < objs.size(); ++k) {
+      Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+      Eigen::Vector2d hi = -lo;
+      for (const std::int32_t i : objs[k]) {
+        const Eigen::Vector2d p(points_.x[static_cast<std::size_t>(i)], points_.y[static_cast<std::size_t>(i)]);
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+      }
+      const bool small = objs[k].empty() || (hi - lo).norm() < params_.manager.small_object_extent;
+      order[k] = {{small, objs[k].size()}, k};
+    }
+    std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) {
+      if (a.first.first != b.first.first) return !a.first.first;  // rectangles first
+      return a.first.second > b.first.second;
+    });
+    std::vector<std::vector<std::int32_t>> sorted(objs.size());
+    for (std::size_t k = 0; k < order.size(); ++k) sorted[k] = std::move(objs[order[k].second]);
+    objs.swap(sorted);
+  }
   created_.clear();
   for (std::size_t k = 0; k < objs.size(); ++k) {
     const auto& idx = objs[k];

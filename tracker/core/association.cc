@@ -25,15 +25,6 @@ std::string Bad(const char* key, double value, const char* constraint) {
 // for distances in metres, is left out (exact when one term is 0, within one ulp otherwise).
 inline double Sq(double a, double b) { return a * a + b * b; }
 
-// Orders box-frame points by their signed distance to the rectangle boundary (> 0 outside,
-// <= 0 inside): the distance inside, its square outside.
-double SignedBoxDistanceKey(const Eigen::Vector2d& q, double half_l, double half_w) {
-  const double dx = std::abs(q.x()) - half_l;
-  const double dy = std::abs(q.y()) - half_w;
-  if (dx > 0.0 || dy > 0.0) return Sq(std::max(dx, 0.0), std::max(dy, 0.0));
-  return std::max(dx, dy);
-}
-
 // Squared distance of a box-frame point to face f (a segment of the rectangle boundary).
 double FaceDistanceSq(const Eigen::Vector2d& q, Face f, double half_l, double half_w) {
   switch (f) {
@@ -306,17 +297,65 @@ double Associator::GateMargin(const PredictedObject& t) const {
                   params_.gate_margin + params_.gate_sigma * std::max(0.0, t.position_std));
 }
 
+void Associator::SortedBoxes::Build(const std::vector<Eigen::Vector2d>& lo,
+                                     const std::vector<Eigen::Vector2d>& hi,
+                                     const std::vector<char>& use) {
+  order.clear();
+  max_width = 0.0;
+  for (std::size_t k = 0; k < lo.size(); ++k) {
+    if (!use.empty() && !use[k]) continue;
+    order.push_back(static_cast<std::int32_t>(k));
+    max_width = std::max(max_width, hi[k].x() - lo[k].x());
+  }
+  std::sort(order.begin(), order.end(), [&](std::int32_t a, std::int32_t b) {
+    const double xa = lo[static_cast<std::size_t>(a)].x(), xb = lo[static_cast<std::size_t>(b)].x();
+    return xa < xb || (xa == xb && a < b);
+  });
+  lo_x.resize(order.size());
+  id.resize(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    id[k] = order[k];
+    lo_x[k] = lo[static_cast<std::size_t>(order[k])].x();
+  }
+}
+
+void Associator::SortedBoxes::Candidates(double lo, double hi, std::vector<std::int32_t>* ids) const {
+  // A box overlapping [lo, hi] in x has lo_x <= hi and hi_x >= lo, hence lo_x >= lo - max_width
+  // (1 m of slack for the rounding of the widths; the caller tests the overlap exactly).
+  const auto b = std::lower_bound(lo_x.begin(), lo_x.end(), lo - max_width - 1.0);
+  const auto e = std::upper_bound(b, lo_x.end(), hi);
+  const std::size_t first = ids->size();
+  for (auto it = b; it != e; ++it) ids->push_back(id[static_cast<std::size_t>(it - lo_x.begin())]);
+  std::sort(ids->begin() + static_cast<std::ptrdiff_t>(first), ids->end());  // caller's order
+}
+
 double Associator::PairCost(const PredictedObject& t, double margin, std::uint8_t visible,
                             const Part& part, const WorldPoints& pts,
                             double* inside_fraction) const {
+  *inside_fraction = 0.0;
+  const std::size_t n = part.points.size();
+  if (n == 0) return kInf;
+  // The fewest returns inside the gate for a candidate (inside >= 1 and inside / n >=
+  // min_inside_fraction, evaluated as below); once more returns than n - need lie outside, the
+  // part is no candidate whatever the rest, and the loop stops (large segments, facades, overlap
+  // the gates of many tracks with few of their returns inside).
+  const double nd = static_cast<double>(n);
+  std::size_t need = static_cast<std::size_t>(std::max(1.0, std::ceil(params_.min_inside_fraction * nd)));
+  while (need > 1 && static_cast<double>(need - 1) / nd >= params_.min_inside_fraction) --need;
+  while (need <= n && static_cast<double>(need) / nd < params_.min_inside_fraction) ++need;
+  if (need > n) return kInf;
+  const std::size_t max_outside = n - need;
   const double hl = 0.5 * t.box.length, hw = 0.5 * t.box.width;
-  int inside = 0;
+  std::size_t inside = 0, outside = 0;
   double dist_sum = 0.0;
   const BoxFrame frame(t.box);
   for (const std::int32_t i : part.points) {
     const auto iu = static_cast<std::size_t>(i);
     const Eigen::Vector2d q = frame.To(pts.x[iu], pts.y[iu]);
-    if (std::abs(q.x()) > hl + margin || std::abs(q.y()) > hw + margin) continue;
+    if (std::abs(q.x()) > hl + margin || std::abs(q.y()) > hw + margin) {
+      if (++outside > max_outside) return kInf;
+      continue;
+    }
     ++inside;
     double d2 = kInf;
     for (int f = 0; f < 4; ++f) {
@@ -324,29 +363,43 @@ double Associator::PairCost(const PredictedObject& t, double margin, std::uint8_
     }
     dist_sum += std::sqrt(d2);
   }
-  const double frac = part.points.empty() ? 0.0 : static_cast<double>(inside) / part.points.size();
+  const double frac = static_cast<double>(inside) / nd;
   *inside_fraction = frac;
   if (inside == 0 || frac < params_.min_inside_fraction) return kInf;
-  return dist_sum / inside + params_.outside_penalty * (1.0 - frac);
+  return dist_sum / static_cast<double>(inside) + params_.outside_penalty * (1.0 - frac);
 }
 
 void Associator::BuildParts(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
                             const Segments& segments) {
-  parts_.clear();
-  std::vector<Eigen::Vector2d> lo(tracks.size()), hi(tracks.size());
-  for (std::size_t j = 0; j < tracks.size(); ++j) {
-    GateBounds(tracks[j].box, GateMargin(tracks[j]), &lo[j], &hi[j]);
+  num_parts_ = 0;
+  const std::size_t nt = tracks.size();
+  // Per track once per scan: gate bounds, frame (cos/sin) and grown half sizes. Only established
+  // tracks claim, so only their gates are indexed.
+  std::vector<Eigen::Vector2d> lo(nt), hi(nt);
+  std::vector<char> established(nt, 0);
+  std::vector<BoxFrame> frames;
+  frames.reserve(nt);
+  std::vector<double> gate_hl(nt), gate_hw(nt);
+  for (std::size_t j = 0; j < nt; ++j) {
+    const double margin = GateMargin(tracks[j]);
+    GateBounds(tracks[j].box, margin, &lo[j], &hi[j]);
+    established[j] = tracks[j].established ? 1 : 0;
+    frames.emplace_back(tracks[j].box);
+    gate_hl[j] = 0.5 * tracks[j].box.length + margin;
+    gate_hw[j] = 0.5 * tracks[j].box.width + margin;
   }
+  sorted_.Build(lo, hi, established);
   std::vector<std::size_t> claim;
-  std::vector<BoxFrame> claim_frames;  // of the claiming tracks (cos/sin once per segment)
   for (const Segment& s : segments.segments) {
-    // Established tracks with enough of this segment's returns inside their gate.
+    // Established tracks with enough of this segment's returns inside their gate, in track order.
     claim.clear();
-    for (std::size_t j = 0; j < tracks.size(); ++j) {
-      if (!tracks[j].established || !Overlap(s.min, s.max, lo[j], hi[j])) continue;
-      const double margin = GateMargin(tracks[j]);
-      const double hl = 0.5 * tracks[j].box.length + margin, hw = 0.5 * tracks[j].box.width + margin;
-      const BoxFrame frame(tracks[j].box);
+    candidates_.clear();
+    sorted_.Candidates(s.min.x(), s.max.x(), &candidates_);
+    for (const std::int32_t jj : candidates_) {
+      const auto j = static_cast<std::size_t>(jj);
+      if (!Overlap(s.min, s.max, lo[j], hi[j])) continue;
+      const double hl = gate_hl[j], hw = gate_hw[j];
+      const BoxFrame& frame = frames[j];
       int inside = 0;  // counted up to split_min_points: all the claim needs
       for (std::int32_t k = s.begin; k < s.end && inside < params_.split_min_points; ++k) {
         const auto i = static_cast<std::size_t>(segments.point[static_cast<std::size_t>(k)]);
@@ -355,34 +408,51 @@ void Associator::BuildParts(const std::vector<PredictedObject>& tracks, const Wo
       }
       if (inside >= params_.split_min_points) claim.push_back(j);
     }
-    const std::size_t first = parts_.size();
+    const std::size_t first = num_parts_;
     const std::size_t num_parts = claim.size() >= 2 ? claim.size() : 1;
-    parts_.resize(first + num_parts);
-    claim_frames.clear();
-    if (num_parts > 1) {
-      for (const std::size_t j : claim) claim_frames.emplace_back(tracks[j].box);
-    }
-    for (std::int32_t k = s.begin; k < s.end; ++k) {
-      const std::int32_t i = segments.point[static_cast<std::size_t>(k)];
-      std::size_t best = 0;
-      if (num_parts > 1) {
+    if (parts_.size() < first + num_parts) parts_.resize(first + num_parts);
+    for (std::size_t q = first; q < first + num_parts; ++q) parts_[q].points.clear();
+    num_parts_ = first + num_parts;
+    const auto seg_begin = segments.point.begin() + s.begin;
+    const auto seg_end = segments.point.begin() + s.end;
+    if (num_parts == 1) {
+      parts_[first].points.assign(seg_begin, seg_end);
+    } else {
+      // Each return goes to the claimant it is nearest to, ordered by the signed distance to
+      // the rectangle boundary (> 0 outside, <= 0 inside): the distance inside, its square
+      // outside. Most segments of a KITTI scan are claimed by two or more tracks (clutter
+      // tracks on vegetation and walls overlap): the claimants' frames side by side.
+      claimants_.clear();
+      for (const std::size_t j : claim) {
+        claimants_.push_back({frames[j].c.x(), frames[j].c.y(), frames[j].ax, frames[j].ay,
+                              0.5 * tracks[j].box.length, 0.5 * tracks[j].box.width});
+      }
+      const Claimant* const cl = claimants_.data();
+      const std::size_t nc = claimants_.size();
+      for (auto it = seg_begin; it != seg_end; ++it) {
+        const std::int32_t i = *it;
+        const auto iu = static_cast<std::size_t>(i);
+        const double px = pts.x[iu], py = pts.y[iu];
+        std::size_t best = 0;
         double best_d = kInf;
-        for (std::size_t c = 0; c < claim.size(); ++c) {
-          const OrientedBox& b = tracks[claim[c]].box;
-          const auto iu = static_cast<std::size_t>(i);
-          const double d = SignedBoxDistanceKey(claim_frames[c].To(pts.x[iu], pts.y[iu]),
-                                                0.5 * b.length, 0.5 * b.width);
+        for (std::size_t c = 0; c < nc; ++c) {
+          const double dx = px - cl[c].cx, dy = py - cl[c].cy;
+          const double qx = dx * cl[c].ax + dy * cl[c].ay, qy = -dx * cl[c].ay + dy * cl[c].ax;
+          const double ex = std::abs(qx) - cl[c].hl, ey = std::abs(qy) - cl[c].hw;
+          const double ox = std::max(ex, 0.0), oy = std::max(ey, 0.0);
+          const double d = ex > 0.0 || ey > 0.0 ? ox * ox + oy * oy : std::max(ex, ey);
           if (d < best_d) {
             best_d = d;
             best = c;
           }
         }
+        parts_[first + best].points.push_back(i);
       }
-      parts_[first + best].points.push_back(i);
     }
-    // Bounding boxes; drop pieces of a split that are too small to fit.
+    // Bounding boxes; drop pieces of a split that are too small to fit (their buffers are kept
+    // for reuse: swapped, not moved, to the end).
     std::size_t w = first;
-    for (std::size_t q = first; q < parts_.size(); ++q) {
+    for (std::size_t q = first; q < num_parts_; ++q) {
       Part& part = parts_[q];
       if (num_parts > 1 && static_cast<int>(part.points.size()) < params_.split_min_points) continue;
       part.min = Eigen::Vector2d::Constant(kInf);
@@ -392,10 +462,14 @@ void Associator::BuildParts(const std::vector<PredictedObject>& tracks, const Wo
         part.min = part.min.cwiseMin(p);
         part.max = part.max.cwiseMax(p);
       }
-      if (w != q) parts_[w] = std::move(part);
+      if (w != q) {
+        std::swap(parts_[w].points, part.points);
+        parts_[w].min = part.min;
+        parts_[w].max = part.max;
+      }
       ++w;
     }
-    parts_.resize(w);
+    num_parts_ = w;
   }
 }
 
@@ -412,12 +486,13 @@ void Associator::Run(const std::vector<PredictedObject>& tracks, const WorldPoin
   out->num_ignored = 0;
 
   BuildParts(tracks, pts, segments);
-  out->num_split = static_cast<std::int32_t>(parts_.size()) -
+  out->num_split = static_cast<std::int32_t>(num_parts_) -
                    static_cast<std::int32_t>(segments.segments.size());
   if (out->num_split < 0) out->num_split = 0;
-  const std::size_t np = parts_.size();
+  const std::size_t np = num_parts_;
 
-  // Candidate pairs and their costs.
+  // Candidate pairs and their costs, in (track, part) order; each track's gate is tested only
+  // against the parts whose x range may overlap it.
   struct Pair {
     int track, part;
     double cost, inside;
@@ -425,35 +500,73 @@ void Associator::Run(const std::vector<PredictedObject>& tracks, const WorldPoin
   std::vector<Pair> pairs;
   std::vector<double> margins(nt);
   std::vector<Eigen::Vector2d> lo(nt), hi(nt);
+  {
+    std::vector<Eigen::Vector2d> part_lo(np), part_hi(np);
+    for (std::size_t q = 0; q < np; ++q) {
+      part_lo[q] = parts_[q].min;
+      part_hi[q] = parts_[q].max;
+    }
+    sorted_.Build(part_lo, part_hi, {});
+  }
   const double slant = DegToRad(params_.min_slant_deg);
   for (std::size_t j = 0; j < nt; ++j) {
     margins[j] = GateMargin(tracks[j]);
     GateBounds(tracks[j].box, margins[j], &lo[j], &hi[j]);
-    std::uint8_t visible = VisibleFaces(tracks[j].box, sensor_xy, slant);
-    if (visible == 0) visible = 0xF;  // sensor inside or on the rectangle: any face
-    for (std::size_t q = 0; q < np; ++q) {
+    candidates_.clear();
+    sorted_.Candidates(lo[j].x(), hi[j].x(), &candidates_);
+    std::uint8_t visible = 0;
+    bool have_visible = false;
+    for (const std::int32_t qq : candidates_) {
+      const auto q = static_cast<std::size_t>(qq);
       if (!Overlap(parts_[q].min, parts_[q].max, lo[j], hi[j])) continue;
+      if (!have_visible) {
+        visible = VisibleFaces(tracks[j].box, sensor_xy, slant);
+        if (visible == 0) visible = 0xF;  // sensor inside or on the rectangle: any face
+        have_visible = true;
+      }
       double inside = 0.0;
       const double c = PairCost(tracks[j], margins[j], visible, parts_[q], pts, &inside);
       if (std::isfinite(c)) pairs.push_back({static_cast<int>(j), static_cast<int>(q), c, inside});
     }
   }
 
-  // Connected components of the candidate graph: nodes 0..nt-1 tracks, nt.. parts.
-  UnionFind uf(static_cast<int>(nt + np));
+  // Connected components of the candidate graph: nodes 0..nt-1 tracks, nt.. parts. Members of
+  // each component (by root) and its pairs are listed by a counting sort, in index order.
+  const std::size_t nn = nt + np;
+  UnionFind uf(static_cast<int>(nn));
   for (const Pair& pr : pairs) uf.Join(pr.track, static_cast<int>(nt) + pr.part);
   std::vector<int> part_track(np, -1);
   {
-    std::vector<std::vector<int>> comp_tracks(nt + np), comp_parts(nt + np);
-    for (std::size_t j = 0; j < nt; ++j) comp_tracks[static_cast<std::size_t>(uf.Find(static_cast<int>(j)))].push_back(static_cast<int>(j));
-    for (std::size_t q = 0; q < np; ++q) comp_parts[static_cast<std::size_t>(uf.Find(static_cast<int>(nt + q)))].push_back(static_cast<int>(q));
+    std::vector<int> root(nn);
+    std::vector<std::size_t> node_start(nn + 1, 0), pair_start(nn + 1, 0);
+    for (std::size_t k = 0; k < nn; ++k) {
+      root[k] = uf.Find(static_cast<int>(k));
+      ++node_start[static_cast<std::size_t>(root[k]) + 1];
+    }
+    for (const Pair& pr : pairs) ++pair_start[static_cast<std::size_t>(root[static_cast<std::size_t>(pr.track)]) + 1];
+    for (std::size_t c = 0; c < nn; ++c) {
+      node_start[c + 1] += node_start[c];
+      pair_start[c + 1] += pair_start[c];
+    }
+    std::vector<int> nodes(nn);
+    std::vector<const Pair*> comp_pairs(pairs.size());
+    {
+      std::vector<std::size_t> fill(node_start.begin(), node_start.end() - 1);
+      for (std::size_t k = 0; k < nn; ++k) nodes[fill[static_cast<std::size_t>(root[k])]++] = static_cast<int>(k);
+      fill.assign(pair_start.begin(), pair_start.end() - 1);
+      for (const Pair& pr : pairs) comp_pairs[fill[static_cast<std::size_t>(root[static_cast<std::size_t>(pr.track)])]++] = &pr;
+    }
     std::vector<int> row_of(nt, -1), col_of(np, -1);
-    std::vector<std::vector<const Pair*>> pairs_by_comp(nt + np);
-    for (const Pair& pr : pairs) pairs_by_comp[static_cast<std::size_t>(uf.Find(pr.track))].push_back(&pr);
+    std::vector<int> ct, cp;
     std::vector<double> cost;
-    for (std::size_t c = 0; c < nt + np; ++c) {
-      const auto& ct = comp_tracks[c];
-      const auto& cp = comp_parts[c];
+    for (std::size_t c = 0; c < nn; ++c) {
+      ct.clear();
+      cp.clear();
+      for (std::size_t k = node_start[c]; k < node_start[c + 1]; ++k) {
+        const int node = nodes[k];
+        if (node < static_cast<int>(nt)) ct.push_back(node);
+        else cp.push_back(node - static_cast<int>(nt));
+      }
       if (ct.empty() || cp.empty()) continue;
       const int rows = static_cast<int>(ct.size());
       const int cols = static_cast<int>(cp.size()) + rows;  // + one "unassigned" column per row
@@ -465,10 +578,11 @@ void Associator::Run(const std::vector<PredictedObject>& tracks, const WorldPoin
       for (int r = 0; r < rows; ++r) {
         cost[static_cast<std::size_t>(r) * cols + cp.size() + static_cast<std::size_t>(r)] = params_.miss_cost;
       }
-      for (const Pair* pr : pairs_by_comp[c]) {
+      for (std::size_t k = pair_start[c]; k < pair_start[c + 1]; ++k) {
+        const Pair* pr = comp_pairs[k];
         const int r = row_of[static_cast<std::size_t>(pr->track)];
-        const int k = col_of[static_cast<std::size_t>(pr->part)];
-        cost[static_cast<std::size_t>(r) * cols + static_cast<std::size_t>(k)] = pr->cost;
+        const int col = col_of[static_cast<std::size_t>(pr->part)];
+        cost[static_cast<std::size_t>(r) * cols + static_cast<std::size_t>(col)] = pr->cost;
       }
       const std::vector<int> assign = SolveAssignment(cost, rows, cols);
       for (int r = 0; r < rows; ++r) {
@@ -480,9 +594,20 @@ void Associator::Run(const std::vector<PredictedObject>& tracks, const WorldPoin
         const int q = cp[static_cast<std::size_t>(k)];
         part_track[static_cast<std::size_t>(q)] = j;
         out->track_cost[static_cast<std::size_t>(j)] = c_rk;
-        out->track_points[static_cast<std::size_t>(j)] = parts_[static_cast<std::size_t>(q)].points;
+        // The part is not read again once assigned: its returns move to the track.
+        std::swap(out->track_points[static_cast<std::size_t>(j)], parts_[static_cast<std::size_t>(q)].points);
       }
     }
+  }
+
+  // The candidate pairs of each part, in pair order (counting sort).
+  std::vector<std::size_t> part_pair_start(np + 1, 0);
+  for (const Pair& pr : pairs) ++part_pair_start[static_cast<std::size_t>(pr.part) + 1];
+  for (std::size_t q = 0; q < np; ++q) part_pair_start[q + 1] += part_pair_start[q];
+  std::vector<const Pair*> part_pairs(pairs.size());
+  {
+    std::vector<std::size_t> fill(part_pair_start.begin(), part_pair_start.end() - 1);
+    for (const Pair& pr : pairs) part_pairs[fill[static_cast<std::size_t>(pr.part)]++] = &pr;
   }
 
   // Leftover parts: merge into an assigned track that holds most of them, else new objects.
@@ -491,8 +616,8 @@ void Associator::Run(const std::vector<PredictedObject>& tracks, const WorldPoin
     int best = -1;
     double best_inside = 0.0;
     bool on_some_box = false, candidate = false;
-    for (const Pair& pr : pairs) {
-      if (pr.part != static_cast<int>(q)) continue;
+    for (std::size_t k = part_pair_start[q]; k < part_pair_start[q + 1]; ++k) {
+      const Pair& pr = *part_pairs[k];
       candidate = true;
       // A piece of the same object lies on its rectangle (the gate without the growth for the
       // position uncertainty) and does not stretch the object beyond the dimensions seen so far

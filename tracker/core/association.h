@@ -125,6 +125,20 @@ class Associator {
     std::vector<std::int32_t> points;
     Eigen::Vector2d min, max;
   };
+  // Boxes sorted by their lower x bound, for the overlap tests of boxes against boxes (tracks'
+  // gates against segments or parts): those are O(tracks x segments), most of them disjoint.
+  struct SortedBoxes {
+    std::vector<double> lo_x;                // ascending
+    std::vector<std::int32_t> id;            // caller's index of each box, in lo_x order
+    double max_width = 0.0;                  // [m] largest hi_x - lo_x
+    std::vector<std::int32_t> order;         // scratch
+    // Sorts the boxes k with use[k] != 0 (every box if use is empty).
+    void Build(const std::vector<Eigen::Vector2d>& lo, const std::vector<Eigen::Vector2d>& hi,
+               const std::vector<char>& use);
+    // Appends to *ids, ascending, the boxes whose x range may overlap [lo_x, hi_x] (a superset:
+    // the caller still tests the overlap).
+    void Candidates(double lo, double hi, std::vector<std::int32_t>* ids) const;
+  };
   void BuildParts(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
                   const Segments& segments);
   // Cost of (track, part), or +inf if the part is not a candidate of the track.
@@ -132,7 +146,15 @@ class Associator {
                   const WorldPoints& pts, double* inside_fraction) const;
 
   AssociationParams params_;
-  std::vector<Part> parts_;
+  // Scratch reused from scan to scan (no allocation per segment or part once warm).
+  std::vector<Part> parts_;                // [0, num_parts_) in use; the rest keep their buffers
+  std::size_t num_parts_ = 0;
+  SortedBoxes sorted_;
+  std::vector<std::int32_t> candidates_;
+  struct Claimant {  // a track claiming part of a segment: frame and half sizes
+    double cx, cy, ax, ay, hl, hw;
+  };
+  std::vector<Claimant> claimants_;
 };
 
 }  // namespace vtrack

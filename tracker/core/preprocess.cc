@@ -88,7 +88,6 @@ Preprocessor::Preprocessor(const PreprocessParams& params) : params_(params) {}
 PreprocessResult Preprocessor::Run(const LadarScan& scan, const PoseHistory& poses,
                                    std::int64_t max_extrapolation_us, WorldPoints* out) {
   PreprocessResult result;
-  out->clear();
   const std::size_t n = scan.size();
   result.stats.input = static_cast<std::int64_t>(n);
 
@@ -105,6 +104,7 @@ PreprocessResult Preprocessor::Run(const LadarScan& scan, const PoseHistory& pos
     PoseHistory::LookupStatus st;
     const auto world_from_body = poses.At(t, max_extrapolation_us, &st);
     if (!world_from_body) {
+      out->clear();
       result.status = CompensationStatus::kNoPose;
       result.failed_lookup = st;
       return result;
@@ -137,7 +137,15 @@ PreprocessResult Preprocessor::Run(const LadarScan& scan, const PoseHistory& pos
   const bool cloud_3d = scan.num_rings >= params_.ground_min_rings;
   const bool grid_ground = cloud_3d && params_.ground == PreprocessParams::Ground::kGrid;
   const double inv_step = 1.0 / static_cast<double>(step);
-  // Written by index into arrays sized for every return, trimmed at the end (no push_back).
+  if (fraction_.size() != static_cast<std::size_t>(step) + 1) {
+    fraction_.resize(static_cast<std::size_t>(step) + 1);
+    for (std::int64_t r = 0; r <= step; ++r) {
+      fraction_[static_cast<std::size_t>(r)] = static_cast<double>(r) / static_cast<double>(step);
+    }
+  }
+  const double* const fraction = fraction_.data();
+  // Written by index into arrays sized for every return, trimmed at the end (no push_back). Not
+  // cleared first: resize() then value-initialises only what the previous scan did not use.
   out->x.resize(n);
   out->y.resize(n);
   out->height.resize(n);
@@ -173,7 +181,9 @@ PreprocessResult Preprocessor::Run(const LadarScan& scan, const PoseHistory& pos
     const std::int64_t k = std::min<std::int64_t>(q, num_intervals - 1);
     const std::int64_t t0 = k * step;
     const std::int64_t t1 = std::min((k + 1) * step, sweep);
-    const double f = t1 > t0 ? static_cast<double>(dt - t0) / static_cast<double>(t1 - t0) : 0.0;
+    const double f = t1 - t0 == step ? fraction[dt - t0]
+                     : t1 > t0       ? static_cast<double>(dt - t0) / static_cast<double>(t1 - t0)
+                                     : 0.0;
     const auto& m = knot_m_[static_cast<std::size_t>(k)];
     const auto& d = knot_d_[static_cast<std::size_t>(k)];
     const double wx = (m(0, 0) + f * d(0, 0)) * px + (m(0, 1) + f * d(0, 1)) * py +
@@ -238,8 +248,13 @@ void Preprocessor::RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts,
   // Within max_range of the sensor, hence inside the grid (with one spare ring of cells) — unless
   // the ego pose jumps within the sweep: clamped before the conversion to int (which would be
   // undefined for a return 1e9 m away; found by tests/fuzz/tracker_fuzzer.cc), NaN to the edge.
+  // offset / cell, by a multiplication when 1 / cell is exact (cell a power of two, as the
+  // default 1 m): the same quotient without a division per return.
+  int cell_exp = 0;
+  const bool exact_inverse = std::frexp(cell, &cell_exp) == 0.5;
+  const double inv_cell = 1.0 / cell;
   const auto cell_index = [&](double offset) {
-    const double c = offset / cell;
+    const double c = exact_inverse ? offset * inv_cell : offset / cell;
     return c >= 1.0 && c <= side - 2.0 ? static_cast<int>(c) : (c > side - 2.0 ? side - 2 : 1);
   };
   for (std::size_t i = 0; i < n; ++i) {

@@ -105,6 +105,9 @@ class Preprocessor {
   PreprocessParams params_;
   // Knots: world_from_sensor rows x and y (3x4 each, as 2x4) and their differences.
   std::vector<Eigen::Matrix<double, 2, 4>> knot_m_, knot_d_;
+  // fraction_[r] = r / knot_us for r in [0, knot_us]: a return's position within its knot
+  // interval by a look-up, not a division per return (the same quotients, computed once).
+  std::vector<double> fraction_;
   // Ground grid.
   std::vector<float> cell_min_, cell_ground_;
   std::vector<std::int32_t> point_cell_;

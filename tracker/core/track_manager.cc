@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "tracker/core/angle.h"
+#include "tracker/core/fast_atan2.h"
 
 namespace vtrack {
 namespace {
@@ -71,11 +72,26 @@ void RangeProfile::Build(const Eigen::Vector2d& sensor_xy, const std::vector<dou
   for (std::size_t i = 0; rings && i < x.size(); ++i) num_rings_ = std::max(num_rings_, ring_of(i) + 1);
   nearest_.assign(static_cast<std::size_t>(num_rings_) * static_cast<std::size_t>(num_bins_),
                   std::numeric_limits<float>::infinity());
+  // The bin Bin() gives, with Atan2Approx wherever its error bound (with ample slack for the
+  // rounding of the sum and product) cannot change the floor; else Bin() itself. Same bins.
+  const int n = num_bins_;
+  const double slack = 10.0 * kAtan2ApproxMaxError * inv_bin_ + 1e-9;
   for (std::size_t i = 0; i < x.size(); ++i) {
     const Eigen::Vector2d p(x[i], y[i]);
-    float& r = nearest_[static_cast<std::size_t>(ring_of(i)) * static_cast<std::size_t>(num_bins_) +
-                        static_cast<std::size_t>(Bin(p))];
-    r = std::min(r, static_cast<float>((p - sensor_).norm()));
+    const Eigen::Vector2d d = p - sensor_;
+    const double v = (Atan2Approx(d.y(), d.x()) + kPi) * inv_bin_;
+    const double lo = std::floor(v - slack);
+    int b;
+    if (lo == std::floor(v + slack)) {
+      b = static_cast<int>(lo);  // in [-1, n]: the wrap of Bin() without its two divisions
+      if (b < 0) b += n;
+      else if (b >= n) b -= n;
+    } else {
+      b = Bin(p);
+    }
+    float& r = nearest_[static_cast<std::size_t>(ring_of(i)) * static_cast<std::size_t>(n) +
+                        static_cast<std::size_t>(b)];
+    r = std::min(r, static_cast<float>(d.norm()));
   }
 }
 

@@ -384,11 +384,27 @@ bool Tracker::Process(const LadarScan& scan, bool forced, ScanOutput* out) {
     objs.swap(sorted);
   }
   created_.clear();
+  // World bounding box of each created rectangle grown by gate_margin (plus 1 mm for rounding):
+  // a segment whose bounding box misses it has no return inside, so is not tested return by
+  // return (the loop is objects x created x returns).
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> created_bounds;
   for (std::size_t k = 0; k < objs.size(); ++k) {
     const auto& idx = objs[k];
     if (idx.empty()) continue;
     bool part_of_new = false;
-    for (const OrientedBox& b : created_) {
+    Eigen::Vector2d obj_lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector2d obj_hi = -obj_lo;
+    if (!created_.empty()) {
+      for (const std::int32_t i : idx) {
+        const Eigen::Vector2d p(points_.x[static_cast<std::size_t>(i)], points_.y[static_cast<std::size_t>(i)]);
+        obj_lo = obj_lo.cwiseMin(p);
+        obj_hi = obj_hi.cwiseMax(p);
+      }
+    }
+    for (std::size_t c = 0; c < created_.size(); ++c) {
+      const OrientedBox& b = created_[c];
+      const auto& [box_lo, box_hi] = created_bounds[c];
+      if ((obj_lo.array() > box_hi.array()).any() || (obj_hi.array() < box_lo.array()).any()) continue;
       std::size_t inside = 0;
       for (const std::int32_t i : idx) {
         inside += b.Contains({points_.x[static_cast<std::size_t>(i)], points_.y[static_cast<std::size_t>(i)]},
@@ -403,7 +419,13 @@ bool Tracker::Process(const LadarScan& scan, bool forced, ScanOutput* out) {
     fill(idx);
     if (point_set_.size() == 0) continue;
     if (manager_->Create(point_set_, pre.sensor_xy, seed_of(-1 - static_cast<std::int64_t>(k)))) {
-      created_.push_back(manager_->Box(manager_->tracks().size() - 1));
+      const OrientedBox b = manager_->Box(manager_->tracks().size() - 1);
+      created_.push_back(b);
+      const double c = std::abs(std::cos(b.theta)), sn = std::abs(std::sin(b.theta));
+      const double hl = 0.5 * b.length + params_.association.gate_margin;
+      const double hw = 0.5 * b.width + params_.association.gate_margin;
+      const Eigen::Vector2d half(c * hl + sn * hw + 1e-3, sn * hl + c * hw + 1e-3);
+      created_bounds.emplace_back(b.center - half, b.center + half);
     }
   }
   manager_->EndScan(scan.utime);

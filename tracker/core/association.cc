@@ -611,6 +611,8 @@ void Associator::Run(const std::vector<PredictedObject>& tracks, const WorldPoin
   }
 
   // Leftover parts: merge into an assigned track that holds most of them, else new objects.
+  std::vector<char> own_valid(nt, 0);
+  std::vector<Eigen::Vector2d> own_lo(nt), own_hi(nt);
   for (std::size_t q = 0; q < np; ++q) {
     if (part_track[q] >= 0) continue;
     int best = -1;
@@ -641,15 +643,24 @@ void Associator::Run(const std::vector<PredictedObject>& tracks, const WorldPoin
                               ? 0.0
                               : static_cast<double>(on_box) / static_cast<double>(parts_[q].points.size());
       if (frac >= params_.min_inside_fraction) on_some_box = true;
-      const auto& own_points = out->track_points[static_cast<std::size_t>(pr.track)];
+      // What follows decides only whether this track takes the part: not if frac cannot win.
+      if (!(frac >= params_.merge_fraction && frac > best_inside)) continue;
+      const auto tu = static_cast<std::size_t>(pr.track);
+      const auto& own_points = out->track_points[tu];
       if (own_points.empty()) continue;
-      Eigen::Vector2d lo_own = Eigen::Vector2d::Constant(kInf), hi_own = -lo_own;
-      for (const std::int32_t i : own_points) {
-        const auto iu = static_cast<std::size_t>(i);
-        const Eigen::Vector2d p = frame.To(pts.x[iu], pts.y[iu]);
-        lo_own = lo_own.cwiseMin(p);
-        hi_own = hi_own.cwiseMax(p);
+      // The track's own returns in its frame: computed once, again only after a merge into it.
+      if (!own_valid[tu]) {
+        own_lo[tu] = Eigen::Vector2d::Constant(kInf);
+        own_hi[tu] = -own_lo[tu];
+        for (const std::int32_t i : own_points) {
+          const auto iu = static_cast<std::size_t>(i);
+          const Eigen::Vector2d p = frame.To(pts.x[iu], pts.y[iu]);
+          own_lo[tu] = own_lo[tu].cwiseMin(p);
+          own_hi[tu] = own_hi[tu].cwiseMax(p);
+        }
+        own_valid[tu] = 1;
       }
+      const Eigen::Vector2d lo_own = own_lo[tu], hi_own = own_hi[tu];
       lo_all = lo_all.cwiseMin(lo_own);
       hi_all = hi_all.cwiseMax(hi_own);
       const Eigen::Vector2d own = hi_own - lo_own, all = hi_all - lo_all;
@@ -666,6 +677,7 @@ void Associator::Run(const std::vector<PredictedObject>& tracks, const WorldPoin
     if (best >= 0) {
       auto& dst = out->track_points[static_cast<std::size_t>(best)];
       dst.insert(dst.end(), parts_[q].points.begin(), parts_[q].points.end());
+      own_valid[static_cast<std::size_t>(best)] = 0;
       ++out->num_merged;
     } else if (on_some_box || (candidate && (parts_[q].max - parts_[q].min).norm() < params_.ignore_max_extent)) {
       // On a track's rectangle (grown by gate_margin), or a small piece inside its gate (a

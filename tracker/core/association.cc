@@ -297,36 +297,44 @@ double Associator::GateMargin(const PredictedObject& t) const {
                   params_.gate_margin + params_.gate_sigma * std::max(0.0, t.position_std));
 }
 
-void Associator::SortedBoxes::Build(const std::vector<Eigen::Vector2d>& lo,
-                                     const std::vector<Eigen::Vector2d>& hi,
+void Associator::SortedBoxes::Build(const std::vector<Eigen::Vector2d>& box_lo,
+                                     const std::vector<Eigen::Vector2d>& box_hi,
                                      const std::vector<char>& use) {
   order.clear();
   max_width = 0.0;
-  for (std::size_t k = 0; k < lo.size(); ++k) {
+  for (std::size_t k = 0; k < box_lo.size(); ++k) {
     if (!use.empty() && !use[k]) continue;
     order.push_back(static_cast<std::int32_t>(k));
-    max_width = std::max(max_width, hi[k].x() - lo[k].x());
+    max_width = std::max(max_width, box_hi[k].x() - box_lo[k].x());
   }
   std::sort(order.begin(), order.end(), [&](std::int32_t a, std::int32_t b) {
-    const double xa = lo[static_cast<std::size_t>(a)].x(), xb = lo[static_cast<std::size_t>(b)].x();
+    const double xa = box_lo[static_cast<std::size_t>(a)].x(), xb = box_lo[static_cast<std::size_t>(b)].x();
     return xa < xb || (xa == xb && a < b);
   });
   lo_x.resize(order.size());
+  lo.resize(order.size());
+  hi.resize(order.size());
   id.resize(order.size());
   for (std::size_t k = 0; k < order.size(); ++k) {
+    const auto o = static_cast<std::size_t>(order[k]);
     id[k] = order[k];
-    lo_x[k] = lo[static_cast<std::size_t>(order[k])].x();
+    lo[k] = box_lo[o];
+    hi[k] = box_hi[o];
+    lo_x[k] = box_lo[o].x();
   }
 }
 
-void Associator::SortedBoxes::Candidates(double lo, double hi, std::vector<std::int32_t>* ids) const {
-  // A box overlapping [lo, hi] in x has lo_x <= hi and hi_x >= lo, hence lo_x >= lo - max_width
-  // (1 m of slack for the rounding of the widths; the caller tests the overlap exactly).
-  const auto b = std::lower_bound(lo_x.begin(), lo_x.end(), lo - max_width - 1.0);
-  const auto e = std::upper_bound(b, lo_x.end(), hi);
-  const std::size_t first = ids->size();
-  for (auto it = b; it != e; ++it) ids->push_back(id[static_cast<std::size_t>(it - lo_x.begin())]);
-  std::sort(ids->begin() + static_cast<std::ptrdiff_t>(first), ids->end());  // caller's order
+void Associator::SortedBoxes::Overlapping(const Eigen::Vector2d& q_lo, const Eigen::Vector2d& q_hi,
+                                          std::vector<std::int32_t>* ids) const {
+  ids->clear();
+  // A box overlapping [q_lo, q_hi] in x has lo_x <= q_hi.x and hi_x >= q_lo.x, hence lo_x >=
+  // q_lo.x - max_width (1 m of slack for the rounding of the widths); each is then tested exactly.
+  const auto b = std::lower_bound(lo_x.begin(), lo_x.end(), q_lo.x() - max_width - 1.0);
+  const auto e = std::upper_bound(b, lo_x.end(), q_hi.x());
+  for (auto k = static_cast<std::size_t>(b - lo_x.begin()); k < static_cast<std::size_t>(e - lo_x.begin()); ++k) {
+    if (Overlap(q_lo, q_hi, lo[k], hi[k])) ids->push_back(id[k]);
+  }
+  std::sort(ids->begin(), ids->end());  // the caller's order
 }
 
 double Associator::PairCost(const PredictedObject& t, double margin, std::uint8_t visible,
@@ -393,11 +401,9 @@ void Associator::BuildParts(const std::vector<PredictedObject>& tracks, const Wo
   for (const Segment& s : segments.segments) {
     // Established tracks with enough of this segment's returns inside their gate, in track order.
     claim.clear();
-    candidates_.clear();
-    sorted_.Candidates(s.min.x(), s.max.x(), &candidates_);
+    sorted_.Overlapping(s.min, s.max, &candidates_);
     for (const std::int32_t jj : candidates_) {
       const auto j = static_cast<std::size_t>(jj);
-      if (!Overlap(s.min, s.max, lo[j], hi[j])) continue;
       const double hl = gate_hl[j], hw = gate_hw[j];
       const BoxFrame& frame = frames[j];
       int inside = 0;  // counted up to split_min_points: all the claim needs
@@ -512,13 +518,11 @@ void Associator::Run(const std::vector<PredictedObject>& tracks, const WorldPoin
   for (std::size_t j = 0; j < nt; ++j) {
     margins[j] = GateMargin(tracks[j]);
     GateBounds(tracks[j].box, margins[j], &lo[j], &hi[j]);
-    candidates_.clear();
-    sorted_.Candidates(lo[j].x(), hi[j].x(), &candidates_);
+    sorted_.Overlapping(lo[j], hi[j], &candidates_);
     std::uint8_t visible = 0;
     bool have_visible = false;
     for (const std::int32_t qq : candidates_) {
       const auto q = static_cast<std::size_t>(qq);
-      if (!Overlap(parts_[q].min, parts_[q].max, lo[j], hi[j])) continue;
       if (!have_visible) {
         visible = VisibleFaces(tracks[j].box, sensor_xy, slant);
         if (visible == 0) visible = 0xF;  // sensor inside or on the rectangle: any face

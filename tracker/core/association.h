@@ -129,15 +129,16 @@ class Associator {
   // gates against segments or parts): those are O(tracks x segments), most of them disjoint.
   struct SortedBoxes {
     std::vector<double> lo_x;                // ascending
+    std::vector<Eigen::Vector2d> lo, hi;     // the boxes, in lo_x order
     std::vector<std::int32_t> id;            // caller's index of each box, in lo_x order
     double max_width = 0.0;                  // [m] largest hi_x - lo_x
     std::vector<std::int32_t> order;         // scratch
     // Sorts the boxes k with use[k] != 0 (every box if use is empty).
     void Build(const std::vector<Eigen::Vector2d>& lo, const std::vector<Eigen::Vector2d>& hi,
                const std::vector<char>& use);
-    // Appends to *ids, ascending, the boxes whose x range may overlap [lo_x, hi_x] (a superset:
-    // the caller still tests the overlap).
-    void Candidates(double lo, double hi, std::vector<std::int32_t>* ids) const;
+    // Sets *ids to the boxes that overlap [lo, hi] (closed), ascending.
+    void Overlapping(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi,
+                     std::vector<std::int32_t>* ids) const;
   };
   void BuildParts(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
                   const Segments& segments);

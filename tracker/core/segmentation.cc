@@ -122,13 +122,12 @@ void Segmenter::RunScanLine(const WorldPoints& pts, const Eigen::Vector2d& senso
 void Segmenter::RunGrid(const WorldPoints& pts, const Eigen::Vector2d& sensor_xy, Segments* out) {
   const std::size_t n = pts.size();
   const std::size_t cells = static_cast<std::size_t>(side_) * static_cast<std::size_t>(side_);
-  if (cell_stamp_.size() != cells) {
-    cell_stamp_.assign(cells, 0);
-    cell_slot_.assign(cells, 0);
+  if (cells_.size() != cells) {
+    cells_.assign(cells, Cell{});
     generation_ = 0;
   }
   if (++generation_ == 0) {  // wrapped after 2^32 scans: clear once
-    std::fill(cell_stamp_.begin(), cell_stamp_.end(), 0u);
+    for (Cell& c : cells_) c.stamp = 0;
     generation_ = 1;
   }
   const double inv = 1.0 / params_.cell_size;
@@ -137,7 +136,7 @@ void Segmenter::RunGrid(const WorldPoints& pts, const Eigen::Vector2d& sensor_xy
   occupied_.clear();
   slot_count_.clear();
   point_cell_.resize(n);
-  // Pass 1: cell of every return (outside the grid: -1), occupied cells and their counts.
+  // Pass 1: cell slot of every return (outside the grid: -1), occupied cells and their counts.
   // The outermost ring of cells is never used, so neighbour look-ups need no bounds checks.
   for (std::size_t i = 0; i < n; ++i) {
     const double fx = (pts.x[i] - x0) * inv, fy = (pts.y[i] - y0) * inv;
@@ -146,15 +145,16 @@ void Segmenter::RunGrid(const WorldPoints& pts, const Eigen::Vector2d& sensor_xy
       continue;
     }
     const std::int32_t c = static_cast<std::int32_t>(fy) * side_ + static_cast<std::int32_t>(fx);
-    point_cell_[i] = c;
     const auto cu = static_cast<std::size_t>(c);
-    if (cell_stamp_[cu] != generation_) {
-      cell_stamp_[cu] = generation_;
-      cell_slot_[cu] = static_cast<std::int32_t>(occupied_.size());
+    Cell& cell = cells_[cu];
+    if (cell.stamp != generation_) {
+      cell.stamp = generation_;
+      cell.slot = static_cast<std::int32_t>(occupied_.size());
       occupied_.push_back(c);
       slot_count_.push_back(0);
     }
-    ++slot_count_[static_cast<std::size_t>(cell_slot_[cu])];
+    point_cell_[i] = cell.slot;
+    ++slot_count_[static_cast<std::size_t>(cell.slot)];
   }
   // Counting sort of returns by cell slot.
   const std::size_t m = occupied_.size();
@@ -165,7 +165,7 @@ void Segmenter::RunGrid(const WorldPoints& pts, const Eigen::Vector2d& sensor_xy
   for (std::size_t s = 0; s < m; ++s) slot_count_[s] = slot_start_[s];
   for (std::size_t i = 0; i < n; ++i) {
     if (point_cell_[i] < 0) continue;
-    const auto s = static_cast<std::size_t>(cell_slot_[static_cast<std::size_t>(point_cell_[i])]);
+    const auto s = static_cast<std::size_t>(point_cell_[i]);
     sorted_[static_cast<std::size_t>(slot_count_[s]++)] = static_cast<std::int32_t>(i);
   }
   // Connected components of occupied cells (depth-first, explicit stack).
@@ -189,8 +189,8 @@ void Segmenter::RunGrid(const WorldPoints& pts, const Eigen::Vector2d& sensor_xy
       const std::int32_t c = occupied_[s];
       for (int j = 0; j < num_nb; ++j) {
         const auto nc = static_cast<std::size_t>(c + kDy[j] * side_ + kDx[j]);
-        if (cell_stamp_[nc] != generation_) continue;
-        const auto ns = static_cast<std::size_t>(cell_slot_[nc]);
+        if (cells_[nc].stamp != generation_) continue;
+        const auto ns = static_cast<std::size_t>(cells_[nc].slot);
         if (slot_label_[ns] >= 0) continue;
         slot_label_[ns] = label;
         stack_.push_back(static_cast<std::int32_t>(ns));

@@ -70,8 +70,11 @@ class Segmenter {
   SegmentationParams params_;
   int side_ = 0;
   std::uint32_t generation_ = 0;
-  std::vector<std::uint32_t> cell_stamp_;  // == generation_ if occupied in this scan
-  std::vector<std::int32_t> cell_slot_;    // index into occupied_ for occupied cells
+  struct Cell {                  // side by side: one cache line per look-up
+    std::uint32_t stamp = 0;     // == generation_ if occupied in this scan
+    std::int32_t slot = 0;       // index into occupied_ for occupied cells
+  };
+  std::vector<Cell> cells_;
   std::vector<std::int32_t> occupied_;     // cell ids
   std::vector<std::int32_t> slot_count_, slot_start_, slot_label_;
   std::vector<std::int32_t> point_cell_, sorted_, stack_;

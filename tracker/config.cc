@@ -256,6 +256,7 @@ void Read(const YAML::Node& root, const std::string& origin, TrackerParams* p) {
     s.Get("confirm_updates", &q.confirm_updates);
     s.Get("tentative_max_misses", &q.tentative_max_misses);
     s.Get("coast_max_s", &q.coast_max_s);
+    s.Get("parked_coast_max_s", &q.parked_coast_max_s);
     s.Get("max_position_std", &q.max_position_std);
     s.Get("duplicate_overlap", &q.duplicate_overlap);
     s.Get("range_sigma", &q.range_sigma);

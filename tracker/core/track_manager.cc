@@ -170,6 +170,8 @@ bool TrackManagerParams::Validate(std::string* error) const {
       !Check(p.tentative_max_misses >= 1, "tentative_max_misses", p.tentative_max_misses, "",
              ">= 1", error) ||
       !Check(p.coast_max_s > 0, "coast_max_s", p.coast_max_s, "s", "> 0", error) ||
+      !Check(p.parked_coast_max_s > 0, "parked_coast_max_s", p.parked_coast_max_s, "s", "> 0",
+             error) ||
       !Check(p.max_position_std > 0, "max_position_std", p.max_position_std, "m", "> 0", error) ||
       !Check(p.duplicate_overlap > 0 && p.duplicate_overlap <= 1, "duplicate_overlap",
              p.duplicate_overlap, "", "in (0, 1]", error) ||
@@ -288,14 +290,28 @@ void TrackManager::Predict(std::int64_t utime, std::vector<PredictedObject>* out
     Dimensions(t, t.hyps[static_cast<std::size_t>(t.selected)], &length, &width);
     PredictedObject p;
     p.box = BoxOf(PoseOf(m, h.x), length, width);
+    const TrackHypothesis& sel = t.hyps[static_cast<std::size_t>(t.selected)];
+    p.established = t.status != TrackStatus::kTentative;
     const double a = h.P(idx[0], idx[0]), b = h.P(idx[0], idx[1]), c = h.P(idx[1], idx[1]);
     p.position_std = std::sqrt(std::max(0.0, 0.5 * (a + c) + std::hypot(0.5 * (a - c), b)));
-    p.established = t.status != TrackStatus::kTentative;
-    const TrackHypothesis& sel = t.hyps[static_cast<std::size_t>(t.selected)];
+    if (t.consecutive_misses > 0 && Parked(t)) {
+      // A parked object stays where it is while it is hidden: its rectangle where it was last
+      // measured, grown by gate_margin only. Predicted with its residual velocity and the gate
+      // grown with the motion noise over the missed scans, a lot car hidden for 0.5 s by a
+      // passing vehicle took in the face of the car parked 0.8 m beside it and slid onto it.
+      p.box = BoxOf(PoseOf(ekf_.model(sel.filter.kind), sel.filter.x), length, width);
+      p.position_std = 0.0;
+    }
     p.seen_length = sel.length_est.value_or(0.0);
     p.seen_width = sel.width_est.value_or(0.0);
     out->push_back(p);
   }
+}
+
+bool TrackManager::Parked(const Track& t) const {
+  if (t.status == TrackStatus::kTentative || t.mover) return false;
+  return ekf_.Centre(t.hyps[static_cast<std::size_t>(t.selected)].filter).speed <
+         params_.mover_min_speed;
 }
 
 bool TrackManager::SmallObject(const PointSet& points) const {
@@ -786,7 +802,10 @@ void TrackManager::EndScan(std::int64_t utime) {
       else if (t.num_updates >= params_.confirm_updates) t.status = TrackStatus::kConfirmed;
     } else {
       t.status = updated ? TrackStatus::kConfirmed : TrackStatus::kCoasting;
-      if (static_cast<double>(utime - t.last_update_utime) * 1e-6 > params_.coast_max_s) remove[i] = 1;
+      // A parked object may stay hidden behind stopped traffic for longer than a moving one
+      // may go unseen (max_position_std still applies to both).
+      const double coast_max = Parked(t) ? params_.parked_coast_max_s : params_.coast_max_s;
+      if (static_cast<double>(utime - t.last_update_utime) * 1e-6 > coast_max) remove[i] = 1;
     }
     const Hypothesis h = PredictedSelected(t, utime);
     const auto idx = ekf_.model(h.kind).PoseIndices();

@@ -50,8 +50,11 @@
 //
 // Life cycle. tentative -> confirmed after confirm_updates updates; a tentative track missed in
 // tentative_max_misses consecutive scans is deleted. A confirmed track that gets no update is
-// coasting, and is deleted after coast_max_s without an update or when its position std exceeds
-// max_position_std. Of two tracks whose rectangles overlap by more than duplicate_overlap of
+// coasting, and is deleted after coast_max_s without an update (a parked object: not a mover,
+// slower than mover_min_speed, after parked_coast_max_s: stopped traffic may hide it for longer)
+// or when its position std exceeds max_position_std. A parked object missed on the previous scan
+// is looked for where it was last measured, in its rectangle grown by the association's
+// gate_margin only: it does not move while hidden (Predict). Of two tracks whose rectangles overlap by more than duplicate_overlap of
 // the smaller one, one is deleted: a small object inside a vehicle's rectangle, else the one with
 // fewer updates, else the younger. Ids are never reused within a run.
 #pragma once
@@ -101,6 +104,8 @@ struct TrackManagerParams {
   int confirm_updates = 3;                  // [-] updates to confirm a track
   int tentative_max_misses = 2;             // [-] consecutive misses that delete a tentative track
   double coast_max_s = 1.5;                 // [s] a confirmed track coasts at most this long
+  double parked_coast_max_s = 3.0;          // [s] ... a parked one (not a mover, slower than
+                                            //     mover_min_speed) at most this long
   double max_position_std = 4.0;            // [m] tracks less certain than this are deleted
   double duplicate_overlap = 0.5;           // [-] overlap (of the smaller rectangle) of duplicates
   double range_sigma = 0.03;                // [m] LADAR range noise for fitting (Eq. 18's sigma)
@@ -316,6 +321,8 @@ class TrackManager {
   void AlignVasm(Track* t) const;
   void AlignIsm(Track* t) const;
   bool SmallObject(const PointSet& points) const;
+  // Confirmed or coasting, not a mover, and slower than mover_min_speed.
+  bool Parked(const Track& t) const;
 
   TrackManagerParams params_;
   const Ekf& ekf_;

@@ -97,8 +97,10 @@ bool Tracker::CheckTime(std::int64_t utime, const char* what) {
   // A jump forward longer than any track may coast (a clock step, a log that skips ahead): no
   // track can survive it, and predicting them across it would only let stale tracks (with huge
   // covariances) catch the new returns.
-  const std::int64_t forward_us = std::max(params_.input.time_jump_reset_us,
-                                           static_cast<std::int64_t>(params_.manager.coast_max_s * 1e6));
+  const std::int64_t forward_us = std::max(
+      params_.input.time_jump_reset_us,
+      static_cast<std::int64_t>(
+          std::max(params_.manager.coast_max_s, params_.manager.parked_coast_max_s) * 1e6));
   if (have_time_ && utime > latest_utime_ + forward_us) {
     Reset(std::string(what) + " time jumped forward by " + Str((utime - latest_utime_) / 1000) + " ms");
     latest_utime_ = utime;

@@ -175,13 +175,14 @@ TEST(TrackerLiveTest, UrbanIntersectionLiveWith64LayerScans) {
     std::printf("\n");
   }
   for (const auto& m : r.switches) std::printf("  switch %s\n", m.c_str());
-  // Issue 5 asks for every due vehicle tracked and no identity switch. Not met yet on this scene
-  // (tracker/README.md, open issues: 98.2% of due (vehicle, scan) pairs on this lap and 3
-  // identity switches, with every scan processed; lot cars first seen merged at 35-45 m).
-  // Asserted: about what it achieves, with a margin for a scan or two lost on the bus, so that a
-  // regression fails, with the misses and switches printed above.
-  EXPECT_GE(r.matched * 1000, r.due * 975) << (r.misses.empty() ? "" : r.misses.front());
-  EXPECT_LE(r.id_switches, 6);
+  // Issue 5 asks for every due vehicle tracked and no identity switch. On this lap: no identity
+  // switch, 99.4% of due (vehicle, scan) pairs tracked (2155 of 2169) with every scan processed;
+  // the misses left are a passing car hidden behind others and an oncoming car whose returns at
+  // 33-40 m the ground grid removes (tracker/README.md, open issues). Asserted: no switch when
+  // every scan reached the tracker (at most one if the bus lost some), and 98.5% of the pairs.
+  EXPECT_GE(r.matched * 1000, r.due * 985) << (r.misses.empty() ? "" : r.misses.front());
+  EXPECT_LE(r.id_switches, st.scans_processed >= 119 ? 0 : 1)
+      << (r.switches.empty() ? "" : r.switches.front());
   EXPECT_EQ(r.max_hyps_not_moving, 1);
   EXPECT_LE(r.max_hyps_moving, 4);
   EXPECT_EQ(r.max_hyps_stationary_truth, 1);  // no parked car is judged a mover

@@ -1,18 +1,30 @@
-// tracker-eval-scores TRUTH_LOG TRACKS_LOG [TRACE_VEHICLE_ID]: prints the integration tests' scores of a tracker
-// output (tracker_eval.h); how the figures in tracker/README.md were made.
+// tracker-eval-scores [--max-range M] TRUTH_LOG TRACKS_LOG [TRACE_VEHICLE_ID]: prints the integration
+// tests' scores of a tracker output (tracker_eval.h); how the figures in tracker/README.md were made.
+// --max-range: vehicles within M metres of the ego are scored (default: EvalOptions, 40 m).
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <string>
 
 #include "tests/integration/tracker_eval.h"
 
 int main(int argc, char** argv) {
+  vtrack::testing::EvalOptions opt;
+  if (argc >= 3 && std::string(argv[1]) == "--max-range") {
+    char* end = nullptr;
+    opt.max_range = std::strtod(argv[2], &end);
+    if (end == argv[2] || *end != '\0' || !(opt.max_range > 0.0)) {
+      std::fprintf(stderr, "%s: --max-range %s: not a positive number of metres\n", argv[0], argv[2]);
+      return 2;
+    }
+    argv += 2;
+    argc -= 2;
+  }
   if (argc != 3 && argc != 4) {
-    std::fprintf(stderr, "usage: %s TRUTH_LOG TRACKS_LOG [TRACE_VEHICLE_ID]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s [--max-range M] TRUTH_LOG TRACKS_LOG [TRACE_VEHICLE_ID]\n", argv[0]);
     return 2;
   }
   try {
-    vtrack::testing::EvalOptions opt;
     if (argc == 4) opt.trace_vehicle = std::stoll(argv[3]);
     const auto r = vtrack::testing::EvaluateTracks(argv[1], argv[2], opt);
     for (const auto& m : r.trace) std::printf("%s\n", m.c_str());

@@ -10,6 +10,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "tracker/core/angle.h"
+
 namespace vtrack {
 namespace {
 
@@ -70,7 +72,7 @@ TEST(RangeProfileTest, LowObjectNearTheSensorOnOtherRingsDoesNotHideTheFace) {
 TEST(RangeProfileTest, OccluderOnTheFaceRingsJustBeyondAnEndHidesIt) {
   // A pole 20 m ahead, 0.3 deg beyond the left end's bearing, on ring 32 (one of the face's).
   Cloud c = RearFace();
-  const double bearing = std::atan2(0.9, 40.0) + 0.3 * M_PI / 180.0;
+  const double bearing = std::atan2(0.9, 40.0) + DegToRad(0.3);
   for (double d = -0.05; d <= 0.05; d += 0.01) {
     c.Add(20.0 * std::cos(bearing + d / 20.0), 20.0 * std::sin(bearing + d / 20.0), 32);
   }

@@ -1,0 +1,89 @@
+// TrackManager: a parked track that is missed stays where it was last measured, with the gate of
+// its rectangle only, and coasts longer than a moving one may (track_manager.h, life cycle).
+// The truth is the scene itself: a car parked at a known place, measured, then hidden.
+#include "tracker/core/track_manager.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "tracker/core/ekf.h"
+
+namespace vtrack {
+namespace {
+
+// The corner of a car parked at (20, 5), heading 0, 4.5 x 1.8 m, seen from the origin: its rear
+// face (x = 17.75) and its right side (y = 4.1), as returns relative to the origin (20, 5).
+PointSet ParkedCorner(std::int64_t utime) {
+  PointSet p;
+  p.origin = Eigen::Vector2d(20.0, 5.0);
+  for (double y = 4.1; y <= 5.9 + 1e-9; y += 0.05) {
+    p.x.push_back(static_cast<float>(17.75 - 20.0));
+    p.y.push_back(static_cast<float>(y - 5.0));
+  }
+  for (double x = 17.85; x <= 22.25 + 1e-9; x += 0.1) {
+    p.x.push_back(static_cast<float>(x - 20.0));
+    p.y.push_back(static_cast<float>(4.1 - 5.0));
+  }
+  p.mean_utime = utime;
+  p.extent = std::hypot(4.5, 1.8);
+  return p;
+}
+
+constexpr std::int64_t kStep = 100'000;  // [us] 10 Hz
+
+TEST(ParkedTrackTest, MissedParkedTrackIsLookedForWhereItWasWithoutGateGrowthAndCoastsLonger) {
+  const Ekf ekf;
+  const TrackManagerParams params;
+  TrackManager m(params, ekf, FitParams(), ShapeParams());
+  const Eigen::Vector2d sensor(0.0, 0.0);
+  std::int64_t t = 1'000'000'000;
+  ASSERT_TRUE(m.Create(ParkedCorner(t), sensor, 1));
+  m.EndScan(t);
+  for (int k = 1; k <= 20; ++k) {  // 2 s of the same returns: confirmed, not a mover
+    t += kStep;
+    m.Update(0, ParkedCorner(t), sensor, static_cast<std::uint64_t>(k), nullptr);
+    m.EndScan(t);
+  }
+  ASSERT_EQ(m.tracks().size(), 1u);
+  ASSERT_NE(m.tracks()[0].status, TrackStatus::kTentative);
+  ASSERT_FALSE(m.tracks()[0].mover);
+  std::vector<PredictedObject> seen;
+  m.Predict(t + kStep, &seen);
+  ASSERT_EQ(seen.size(), 1u);
+  EXPECT_GT(seen[0].position_std, 0.0);  // updated on the last scan: the usual grown gate
+  // The rectangle covers the car: centre within 0.3 m of (20, 5) along the side seen whole.
+  EXPECT_NEAR(seen[0].box.center.y(), 5.0, 0.3);
+
+  // Hidden: missed on every scan from now on.
+  const Eigen::Vector2d last_centre = seen[0].box.center;
+  const std::int64_t last_update = t;
+  std::vector<PredictedObject> hidden;
+  for (int k = 1; k <= 20; ++k) {  // 2 s hidden: longer than coast_max_s (1.5 s)
+    t += kStep;
+    m.Predict(t, &hidden);
+    ASSERT_EQ(hidden.size(), 1u) << "deleted after " << (t - last_update) * 1e-6 << " s";
+    if (k >= 2) {  // missed on the previous scan: where it was, gate = rectangle + gate_margin
+      EXPECT_EQ(hidden[0].position_std, 0.0);
+      EXPECT_NEAR((hidden[0].box.center - last_centre).norm(), 0.0, 0.05);
+    }
+    m.Miss(0);
+    m.EndScan(t);
+  }
+  EXPECT_GT(static_cast<double>(t - last_update) * 1e-6, params.coast_max_s);
+  ASSERT_EQ(m.tracks().size(), 1u);  // a parked car behind stopped traffic is kept
+  EXPECT_EQ(m.tracks()[0].status, TrackStatus::kCoasting);
+  // ... but not beyond parked_coast_max_s (or the position std bound, whichever comes first).
+  for (int k = 0; k < 20 && !m.tracks().empty(); ++k) {
+    t += kStep;
+    m.Miss(0);
+    m.EndScan(t);
+  }
+  EXPECT_TRUE(m.tracks().empty());
+  EXPECT_LE(static_cast<double>(t - last_update) * 1e-6, params.parked_coast_max_s + 0.15);
+}
+
+}  // namespace
+}  // namespace vtrack

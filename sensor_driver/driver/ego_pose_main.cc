@@ -28,9 +28,8 @@ int main(int argc, char** argv) {
       ("cache-dir", po::value<std::string>(), "KITTI: where packed point clouds are unpacked")
       ("lcm-url", po::value<std::string>()->default_value(""), "LCM URL (default: LCM's own, or $LCM_DEFAULT_URL)")
       ("channel", po::value<std::string>()->default_value("EGO_POSE"), "channel of the poses")
-      ("laps", po::value<std::int64_t>()->default_value(0), "runs to publish; 0 = until stopped")
-      ("stop-after", po::value<double>()->default_value(0.0), "[s] stop after this much wall time; 0 = never")
       ("quiet,q", "no progress output");
+  vtrack::sim::AddRealtimeOptions(&desc);
   const std::string usage =
       "vtrack-ego-pose: publish the ego vehicle's pose live, from a scenario or KITTI.\n\n"
       "usage: vtrack-ego-pose --scenario NAME [--pose-rate HZ] [--pose-noise-pos M] [--start-utime U]\n"
@@ -53,9 +52,7 @@ int main(int argc, char** argv) {
     auto lcm = vtrack::lcm_util::OpenLcm(vm["lcm-url"].as<std::string>());
     const std::string channel = vm["channel"].as<std::string>();
     vtrack::sim::RealtimeOptions ro;
-    ro.start_utime = cli.start_utime;
-    ro.laps = vm["laps"].as<std::int64_t>();
-    ro.stop_after_s = vm["stop-after"].as<double>();
+    vtrack::sim::ReadRealtimeOptions(vm, cli, &ro);
     ro.name = "vtrack-ego-pose";
     ro.what = "poses";
     ro.late_limit_s = 0.5;

@@ -30,9 +30,8 @@ int main(int argc, char** argv) {
       ("scan-channel", po::value<std::string>()->default_value("LADAR_SCAN"), "channel of the scans")
       ("truth-channel", po::value<std::string>()->default_value("GROUND_TRUTH"), "channel of the ground truth")
       ("no-truth", "do not publish ground truth")
-      ("laps", po::value<std::int64_t>()->default_value(0), "runs to publish; 0 = until stopped")
-      ("stop-after", po::value<double>()->default_value(0.0), "[s] stop after this much wall time; 0 = never")
       ("quiet,q", "no progress output");
+  vtrack::sim::AddRealtimeOptions(&desc);
   const std::string usage =
       "vtrack-ladar-driver: publish LADAR scans and ground truth live, from a scenario or KITTI.\n\n"
       "usage: vtrack-ladar-driver --scenario NAME [--sensor S] [--seed N] [--start-utime U]\n"
@@ -56,9 +55,7 @@ int main(int argc, char** argv) {
     const std::string scan_channel = vm["scan-channel"].as<std::string>();
     const std::string truth_channel = vm.count("no-truth") ? "" : vm["truth-channel"].as<std::string>();
     vtrack::sim::RealtimeOptions ro;
-    ro.start_utime = cli.start_utime;
-    ro.laps = vm["laps"].as<std::int64_t>();
-    ro.stop_after_s = vm["stop-after"].as<double>();
+    vtrack::sim::ReadRealtimeOptions(vm, cli, &ro);
     ro.name = "vtrack-ladar-driver";
     ro.what = "scans";
     if (vm.count("quiet")) ro.progress_interval_s = 0.0;

@@ -14,6 +14,12 @@
 //                     processes started by hand at any moments agree with no option at all.
 // The same U given to vtrack-sim-log writes lap 0's messages: identical contents (seq of lap k is
 // k * scans_per_lap + i live, i in the log).
+//   --rate r          slow motion (r < 1) or fast forward (r > 1), like lcm-logplayer's --speed:
+//                     the message for data time U + t is published at wall time U + t / r, so the
+//                     data (stamps, contents) are those of r = 1 and only the pace changes. For a
+//                     consumer too slow for real time (a sanitizer or debug build, a slow laptop).
+//                     Needs --start-utime: both processes must share U (it is where data time and
+//                     wall time coincide) and r.
 #pragma once
 
 #include <cstdint>
@@ -38,6 +44,8 @@ struct RealtimeOptions {
   std::optional<std::int64_t> start_utime;  // [us] U; unset = 0 (the wall-clock grid)
   std::int64_t laps = 0;                    // laps to run from the first one; 0 = until stopped
   double stop_after_s = 0.0;                // [s] stop after this much wall time; 0 = never
+  double rate = 1.0;                        // data seconds per wall second, > 0; != 1 needs
+                                            // start_utime
   double late_limit_s = 0.5;                // [s] an item overdue by more than this is skipped;
                                             // one overdue by less is still published (a starved
                                             // process catches up in a burst, losing nothing)

@@ -35,6 +35,23 @@ void AddPoseOptions(po::options_description* desc) {
       ("pose-noise-yaw-deg", po::value<double>(), "[deg] 1-sigma Gauss-Markov noise on yaw");
 }
 
+void AddRealtimeOptions(po::options_description* desc) {
+  desc->add_options()
+      ("laps", po::value<std::int64_t>()->default_value(0), "runs to publish; 0 = until stopped")
+      ("stop-after", po::value<double>()->default_value(0.0), "[s] stop after this much wall time; 0 = never")
+      ("rate", po::value<double>()->default_value(1.0),
+       "data seconds per wall second: < 1 slow motion for a consumer slower than real time; "
+       "stamps and contents stay those of rate 1. Needs --start-utime; give the driver and "
+       "vtrack-ego-pose the same");
+}
+
+void ReadRealtimeOptions(const po::variables_map& vm, const SimCli& cli, RealtimeOptions* o) {
+  o->start_utime = cli.start_utime;
+  o->laps = vm["laps"].as<std::int64_t>();
+  o->stop_after_s = vm["stop-after"].as<double>();
+  o->rate = vm["rate"].as<double>();
+}
+
 SimCli ReadSimCli(const po::variables_map& vm) {
   SimCli c;
   auto get = [&](const char* k, auto* out) {

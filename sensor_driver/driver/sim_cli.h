@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 
+#include "sensor_driver/driver/realtime.h"
 #include "sensor_driver/sim/simulator.h"
 
 namespace vtrack::sim {
@@ -26,6 +27,12 @@ void AddScenarioOptions(boost::program_options::options_description* desc, bool 
 void AddSensorOptions(boost::program_options::options_description* desc);
 // --pose-rate, --pose-noise-pos, --pose-noise-yaw-deg.
 void AddPoseOptions(boost::program_options::options_description* desc);
+
+// --laps, --stop-after, --rate: the schedule of the two live processes (realtime.h).
+void AddRealtimeOptions(boost::program_options::options_description* desc);
+// Fills options->laps, stop_after_s, rate and start_utime from vm and cli; the rest is left.
+void ReadRealtimeOptions(const boost::program_options::variables_map& vm, const SimCli& cli,
+                         RealtimeOptions* options);
 
 // Reads the options above that were defined and given. Throws boost::program_options::error for
 // a value no scenario could accept (e.g. a negative --start-utime).

@@ -146,6 +146,85 @@ TEST(SimLiveTest, TenSecondsOfDriverEgoPoseAndLogger) {
   }
 }
 
+// --rate 0.5 (slow motion, for a consumer slower than real time): the messages are byte for byte
+// those of vtrack-sim-log for the same --start-utime, only published at half the pace: the
+// message for data time U + t arrives at wall time U + t / 0.5.
+TEST(SimLiveTest, SlowMotionKeepsTheDataAndHalvesThePace) {
+  VTRACK_REQUIRE_PRIVATE_NETNS();
+  const std::string dir = ScratchDir("sim_live_rate");
+  const std::string log = dir + "/live.lcm";
+  const std::string scenario = "paper_fig4_turn";
+  const double rate = 0.5;
+  const std::int64_t start = (lcm_util::WallUtime() / 1000 + 2500) * 1000;
+  const std::vector<std::string> common{"--scenario", scenario, "--duration", "3", "--start-utime",
+                                        std::to_string(start), "--laps", "1", "--rate", "0.5",
+                                        "--lcm-url", kUrl, "-q"};
+  {
+    Subprocess logger({"lcm-logger", "-q", "-f", std::string("--lcm-url=") + kLoggerUrl, log},
+                      dir + "/logger.txt");
+    std::vector<std::string> d{BinDir() + "/vtrack-ladar-driver"}, e{BinDir() + "/vtrack-ego-pose"};
+    d.insert(d.end(), common.begin(), common.end());
+    e.insert(e.end(), common.begin(), common.end());
+    Subprocess driver(d, dir + "/driver.txt");
+    Subprocess ego(e, dir + "/ego.txt");
+    const auto d_st = driver.Wait(30000ms), e_st = ego.Wait(30000ms);
+    ASSERT_TRUE(d_st.has_value() && e_st.has_value()) << "the run did not end on time";
+    EXPECT_EQ(*d_st, 0) << ReadFile(dir + "/driver.txt");
+    EXPECT_EQ(*e_st, 0) << ReadFile(dir + "/ego.txt");
+    StopLogger(&logger);
+  }
+  const std::string ref = dir + "/ref.lcm";
+  ASSERT_EQ(RunCommand({BinDir() + "/vtrack-sim-log", "--scenario", scenario, "--duration", "3",
+                        "--start-utime", std::to_string(start), "--out", ref, "-q"},
+                       dir + "/sim_log.txt"),
+            0);
+  const auto events = ReadLog(log);
+  const auto live = ByChannel(events), offline = ByChannel(ReadLog(ref));
+  for (const char* ch : {"LADAR_SCAN", "GROUND_TRUTH", "EGO_POSE"}) {
+    ASSERT_TRUE(live.count(ch)) << ch << " missing";
+    ASSERT_EQ(live.at(ch).size(), offline.at(ch).size()) << ch;
+    for (std::size_t i = 0; i < live.at(ch).size(); ++i) {
+      ASSERT_TRUE(live.at(ch)[i] == offline.at(ch)[i]) << ch << " message " << i << " differs";
+    }
+  }
+  // The pace: arrival (logger's wall clock) against the stamp, stretched by 1 / rate from U.
+  int checked = 0;
+  for (const Event& ev : events) {
+    std::int64_t due = 0;
+    if (ev.channel == "LADAR_SCAN") {
+      const auto scan = DecodeOrDie<ladar_scan_t>(ev.data);
+      due = scan.utime + scan.sweep_duration_us;
+    } else if (ev.channel == "EGO_POSE") {
+      due = DecodeOrDie<pose_t>(ev.data).utime;
+    } else {
+      continue;
+    }
+    const double expected = static_cast<double>(start) + static_cast<double>(due - start) / rate;
+    EXPECT_NEAR(static_cast<double>(ev.timestamp), expected, 200000.0) << ev.channel;
+    ++checked;
+  }
+  EXPECT_GT(checked, 300);
+}
+
+// A rate the schedule cannot honour is refused with a message naming it, before anything is sent.
+TEST(SimLiveTest, BadRateIsRefused) {
+  const std::string dir = ScratchDir("sim_live_bad_rate");
+  for (const std::string bin : {"vtrack-ladar-driver", "vtrack-ego-pose"}) {
+    EXPECT_NE(RunCommand({BinDir() + "/" + bin, "--scenario", "paper_fig4_turn", "--rate", "0.5",
+                          "--lcm-url", "memq://"},
+                         dir + "/no_start.txt"),
+              0);
+    EXPECT_NE(ReadFile(dir + "/no_start.txt").find("--start-utime"), std::string::npos)
+        << ReadFile(dir + "/no_start.txt");
+    EXPECT_NE(RunCommand({BinDir() + "/" + bin, "--scenario", "paper_fig4_turn", "--rate", "0",
+                          "--start-utime", "1", "--lcm-url", "memq://"},
+                         dir + "/zero.txt"),
+              0);
+    EXPECT_NE(ReadFile(dir + "/zero.txt").find("--rate"), std::string::npos)
+        << ReadFile(dir + "/zero.txt");
+  }
+}
+
 // No --start-utime: the ego-pose process and the driver, started 1.3 s apart, each join the lap in
 // progress on the wall-clock grid. Every scan's and every pose's content equals vtrack-sim-log's
 // for that lap (seq aside: live it counts on across laps).

@@ -32,4 +32,14 @@ std::string KittiDir() {
   return std::filesystem::is_directory(d) ? d : std::string();
 }
 
+double LiveRate() {
+  if (const char* v = std::getenv("VTRACK_LIVE_RATE"); v != nullptr && *v != '\0') {
+    char* end = nullptr;
+    const double r = std::strtod(v, &end);
+    if (end != v && *end == '\0' && r > 0.0 && r <= 1.0) return r;
+    ADD_FAILURE() << "VTRACK_LIVE_RATE = '" << v << "': must be a number in (0, 1]";
+  }
+  return kSanitizedBuild ? 0.25 : 1.0;
+}
+
 }  // namespace vtrack::testing

@@ -380,6 +380,12 @@ double Associator::PairCost(const PredictedObject& t, double margin, std::uint8_
 void Associator::BuildParts(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
                             const Segments& segments) {
   num_parts_ = 0;
+  // Part buffers are kept from scan to scan, but not beyond twice what this scan's segments
+  // hold: otherwise every slot would keep the largest part it ever held (RSS creeping up over a
+  // long run although nothing leaks).
+  std::size_t retained = 0;
+  for (const Part& part : parts_) retained += part.points.capacity();
+  if (retained > 2 * segments.point.size() + 4096) parts_.clear();
   const std::size_t nt = tracks.size();
   // Per track once per scan: gate bounds, frame (cos/sin) and grown half sizes. Only established
   // tracks claim, so only their gates are indexed.

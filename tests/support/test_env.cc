@@ -39,7 +39,7 @@ double LiveRate() {
     if (end != v && *end == '\0' && r > 0.0 && r <= 1.0) return r;
     ADD_FAILURE() << "VTRACK_LIVE_RATE = '" << v << "': must be a number in (0, 1]";
   }
-  return kSanitizedBuild ? 0.25 : 1.0;
+  return kSanitizedBuild ? 0.2 : 1.0;
 }
 
 }  // namespace vtrack::testing

@@ -34,7 +34,7 @@ inline constexpr bool kSanitizedBuild = false;
 
 // The pace at which live tests publish data too heavy for a slow build in real time (64-layer
 // scans), in data seconds per wall second (the live processes' --rate): $VTRACK_LIVE_RATE if set
-// (a slow machine), else 1 (real time), or 1/4 in a sanitized build. The data, and so every
+// (a slow machine), else 1 (real time), or 1/5 in a sanitized build. The data, and so every
 // assertion on them, are the same at any pace.
 double LiveRate();
 

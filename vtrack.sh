@@ -87,8 +87,12 @@ stop_background() {
 start_sanitizer_build() {
   log "building with ASan + UBSan (clang) in $sanitizer_dir, at low priority in the background"
   mkdir -p "$sanitizer_dir"
-  # setsid: its own process group, so that stop_background ends the compilers too.
+  # setsid: its own process group, so that stop_background ends the compilers too. A new session
+  # is also a new scheduler autogroup (Linux's CONFIG_SCHED_AUTOGROUP), and autogroups share the
+  # CPU equally whatever their tasks' nice: so the autogroup itself is niced (measured: without
+  # that the "nice 19" build took half the CPU from the Release build; with it ~2 %).
   setsid nice -n 19 bash -c '
+    echo 19 > /proc/self/autogroup 2>/dev/null || true
     CC=clang CXX=clang++ cmake -S "$1" -B "$2" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
       -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
       -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
@@ -109,8 +113,9 @@ sanitizer_tests() {
   fi
   start=$(date +%s)
   log "fuzzing every harness for ${VTRACK_FUZZ_SECONDS:-10} s (low priority, beside the tests)"
-  setsid nice -n 19 env VTRACK_FUZZ_BUILD_DIR="$sanitizer_dir" VTRACK_FUZZ_PREBUILT=1 \
-    "$here/scripts/fuzz.sh" "$here" "${VTRACK_FUZZ_SECONDS:-10}" >"$sanitizer_dir/fuzz.log" 2>&1 &
+  setsid nice -n 19 bash -c 'echo 19 > /proc/self/autogroup 2>/dev/null || true
+    VTRACK_FUZZ_BUILD_DIR="$1" VTRACK_FUZZ_PREBUILT=1 exec "$2/scripts/fuzz.sh" "$2" "$3"' \
+    _ "$sanitizer_dir" "$here" "${VTRACK_FUZZ_SECONDS:-10}" >"$sanitizer_dir/fuzz.log" 2>&1 &
   fuzz_pid=$!
   background_pids+=("$fuzz_pid")
   log "running every test under ASan + UBSan"

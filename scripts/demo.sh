@@ -25,7 +25,7 @@
 # network namespace can be made here (needs root or unprivileged user namespaces).
 set -euo pipefail
 
-usage() { sed -n '2,26p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,25p' "$0" | sed 's/^# \{0,1\}//'; }
 die() { echo "demo: $1" >&2; exit "${2:-1}"; }
 say() { printf '\033[1m[demo]\033[0m %s\n' "$*" >&2; }
 

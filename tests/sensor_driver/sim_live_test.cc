@@ -75,6 +75,24 @@ void StopLogger(Subprocess* logger) {
   ASSERT_TRUE(st.has_value()) << "lcm-logger did not stop on SIGINT";
 }
 
+// The driver and the ego-pose process with the same options (`common`), recorded by lcm-logger
+// into `log` until both end (within 30 s).
+void RecordDriverAndEgoPose(const std::string& dir, const std::vector<std::string>& common,
+                            const std::string& log) {
+  Subprocess logger({"lcm-logger", "-q", "-f", std::string("--lcm-url=") + kLoggerUrl, log},
+                    dir + "/logger.txt");
+  std::vector<std::string> d{BinDir() + "/vtrack-ladar-driver"}, e{BinDir() + "/vtrack-ego-pose"};
+  d.insert(d.end(), common.begin(), common.end());
+  e.insert(e.end(), common.begin(), common.end());
+  Subprocess driver(d, dir + "/driver.txt");
+  Subprocess ego(e, dir + "/ego.txt");
+  const auto d_st = driver.Wait(30000ms), e_st = ego.Wait(30000ms);
+  ASSERT_TRUE(d_st.has_value() && e_st.has_value()) << "the run did not end on time";
+  EXPECT_EQ(*d_st, 0) << ReadFile(dir + "/driver.txt");
+  EXPECT_EQ(*e_st, 0) << ReadFile(dir + "/ego.txt");
+  StopLogger(&logger);
+}
+
 TEST(SimLiveTest, TenSecondsOfDriverEgoPoseAndLogger) {
   VTRACK_REQUIRE_PRIVATE_NETNS();
   const std::string dir = ScratchDir("sim_live");
@@ -84,20 +102,8 @@ TEST(SimLiveTest, TenSecondsOfDriverEgoPoseAndLogger) {
   const std::int64_t start = (lcm_util::WallUtime() / 1000 + 2500) * 1000;
   const std::vector<std::string> common{"--scenario", scenario, "--duration", "10", "--start-utime",
                                         std::to_string(start), "--laps", "1", "--lcm-url", kUrl};
-  {
-    Subprocess logger({"lcm-logger", "-q", "-f", std::string("--lcm-url=") + kLoggerUrl, log},
-                      dir + "/logger.txt");
-    std::vector<std::string> d{BinDir() + "/vtrack-ladar-driver"}, e{BinDir() + "/vtrack-ego-pose"};
-    d.insert(d.end(), common.begin(), common.end());
-    e.insert(e.end(), common.begin(), common.end());
-    Subprocess driver(d, dir + "/driver.txt");
-    Subprocess ego(e, dir + "/ego.txt");
-    const auto d_st = driver.Wait(30000ms), e_st = ego.Wait(30000ms);
-    ASSERT_TRUE(d_st.has_value() && e_st.has_value()) << "the run did not end on time";
-    EXPECT_EQ(*d_st, 0) << ReadFile(dir + "/driver.txt");
-    EXPECT_EQ(*e_st, 0) << ReadFile(dir + "/ego.txt");
-    StopLogger(&logger);
-  }
+  RecordDriverAndEgoPose(dir, common, log);
+  ASSERT_FALSE(HasFatalFailure());
   const auto events = ReadLog(log);
   sim::Simulator sim(sim::LoadScenario(sim::ResolveScenarioPath(scenario), 10.0));
   std::vector<ladar_scan_t> scans;
@@ -159,20 +165,8 @@ TEST(SimLiveTest, SlowMotionKeepsTheDataAndHalvesThePace) {
   const std::vector<std::string> common{"--scenario", scenario, "--duration", "3", "--start-utime",
                                         std::to_string(start), "--laps", "1", "--rate", "0.5",
                                         "--lcm-url", kUrl, "-q"};
-  {
-    Subprocess logger({"lcm-logger", "-q", "-f", std::string("--lcm-url=") + kLoggerUrl, log},
-                      dir + "/logger.txt");
-    std::vector<std::string> d{BinDir() + "/vtrack-ladar-driver"}, e{BinDir() + "/vtrack-ego-pose"};
-    d.insert(d.end(), common.begin(), common.end());
-    e.insert(e.end(), common.begin(), common.end());
-    Subprocess driver(d, dir + "/driver.txt");
-    Subprocess ego(e, dir + "/ego.txt");
-    const auto d_st = driver.Wait(30000ms), e_st = ego.Wait(30000ms);
-    ASSERT_TRUE(d_st.has_value() && e_st.has_value()) << "the run did not end on time";
-    EXPECT_EQ(*d_st, 0) << ReadFile(dir + "/driver.txt");
-    EXPECT_EQ(*e_st, 0) << ReadFile(dir + "/ego.txt");
-    StopLogger(&logger);
-  }
+  RecordDriverAndEgoPose(dir, common, log);
+  ASSERT_FALSE(HasFatalFailure());
   const std::string ref = dir + "/ref.lcm";
   ASSERT_EQ(RunCommand({BinDir() + "/vtrack-sim-log", "--scenario", scenario, "--duration", "3",
                         "--start-utime", std::to_string(start), "--out", ref, "-q"},

@@ -143,6 +143,7 @@ void Read(const YAML::Node& root, const std::string& origin, TrackerParams* p) {
     s.Get("ground_cell", &q.ground_cell);
     s.Get("ground_tolerance", &q.ground_tolerance);
     s.Get("ground_max_slope", &q.ground_max_slope);
+    s.Get("ground_max_grade", &q.ground_max_grade);
     s.Get("knot_us", &q.knot_us);
     s.Get("max_points", &q.max_points);
     s.Done();
@@ -263,6 +264,7 @@ void Read(const YAML::Node& root, const std::string& origin, TrackerParams* p) {
     s.Get("fit_contour_deg", &q.fit_contour_deg);
     s.Get("contour_support_height", &q.contour_support_height);
     s.Get("contour_support_range", &q.contour_support_range);
+    s.Get("contour_arc_span", &q.contour_arc_span);
     s.Get("outline_min_slant_deg", &q.outline_min_slant_deg);
     s.Get("outline_min_points", &q.outline_min_points);
     s.Get("outline_min_edge_inliers", &q.outline_min_edge_inliers);

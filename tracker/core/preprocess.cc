@@ -53,6 +53,8 @@ std::string PreprocessParams::FirstProblem() const {
   if (!(ground_tolerance >= 0.0)) return Bad("ground_tolerance", ground_tolerance, "must be >= 0");
   if (!(ground_max_slope >= 0.0 && ground_max_slope <= 1.0))
     return Bad("ground_max_slope", ground_max_slope, "must be in [0, 1]");
+  if (!(ground_max_grade > 0.0 && ground_max_grade <= 10.0))
+    return Bad("ground_max_grade", ground_max_grade, "must be in (0, 10]");
   if (knot_us < 10 || knot_us > 100000)
     return Bad("knot_us", static_cast<double>(knot_us), "must be in [10, 100000]");
   if (max_points < 1) return Bad("max_points", static_cast<double>(max_points), "must be >= 1");
@@ -264,6 +266,30 @@ void Preprocessor::RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts,
     pc[i] = c;
     cmin[c] = std::min(cmin[c], ph[i]);
   }
+  // Upper bound of the ground per cell: min over cells c' of cell_min(c') + grade * |c - c'|, by
+  // the two raster passes of a 3x3 chamfer distance transform (Borgefors 1986; diagonal steps
+  // weighted sqrt(2), which overstates a Euclidean distance by at most 8 %). Written here: OpenCV's
+  // distanceTransform computes distances to zero pixels, not this lower envelope of heights.
+  cell_bound_ = cell_min_;
+  {
+    const float a = static_cast<float>(params_.ground_max_grade * cell);
+    const float d = a * static_cast<float>(std::sqrt(2.0));
+    float* const b = cell_bound_.data();
+    for (int cy = 1; cy < side - 1; ++cy) {
+      for (int cx = 1; cx < side - 1; ++cx) {
+        const std::ptrdiff_t c = static_cast<std::ptrdiff_t>(cy) * side + cx;
+        b[c] = std::min({b[c], b[c - 1] + a, b[c - side - 1] + d, b[c - side] + a,
+                         b[c - side + 1] + d});
+      }
+    }
+    for (int cy = side - 2; cy >= 1; --cy) {
+      for (int cx = side - 2; cx >= 1; --cx) {
+        const std::ptrdiff_t c = static_cast<std::ptrdiff_t>(cy) * side + cx;
+        b[c] = std::min({b[c], b[c + 1] + a, b[c + side + 1] + d, b[c + side] + a,
+                         b[c + side - 1] + d});
+      }
+    }
+  }
   // Overall ground level: median of the lowest return per occupied cell within 20 m of the
   // sensor, where most cells see the road.
   std::vector<float> near_mins;
@@ -300,6 +326,10 @@ void Preprocessor::RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts,
           tol + static_cast<float>(params_.ground_max_slope * cell *
                                    std::hypot(cx - side / 2, cy - side / 2));
       g = std::clamp(m, level - tol_here, level + tol_here);
+      // Above the scan's level by more than the tolerance (far cells only): no higher than the
+      // lowest returns around allow, and no lower than that tolerance (a single low outlier,
+      // which real clouds have, must not pull down the ground of the cells around it).
+      if (g > level + tol) g = std::max(level + tol, std::min(g, cell_bound_[static_cast<std::size_t>(c)]));
     }
     const float h = pts->height[i] - g;
     if (h < min_h || h > max_h) continue;

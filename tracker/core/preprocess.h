@@ -11,6 +11,11 @@
 //     to within ground_tolerance + ground_max_slope * distance of the scan's overall ground
 //     level ("grid"), which follows slopes and any sensor mounting height without
 //     configuration. The clamp keeps a cell that sees only a roof from being taken as ground.
+//     Nearer the sensor that clamp is loose (2.25 m at 33 m), so the local ground is also kept
+//     below the lowest return of every other cell plus ground_max_grade per metre between them:
+//     a car whose lower part another vehicle hides shows only its roof line, the ground around
+//     it is unseen, and the lowest return of its cells is that roof line; the road seen beside
+//     or in front of it bounds its ground instead.
 //
 // Speed: the pose is looked up at "knots" every knot_us over the sweep and the world_from_sensor
 // matrix is interpolated linearly between knots per point. Against slerp at each point's own
@@ -42,6 +47,8 @@ struct PreprocessParams {
   double ground_cell = 1.0;          // [m] grid cell size of the ground estimate (grid method)
   double ground_tolerance = 0.6;     // [m] local ground within this of the scan's ground level,
   double ground_max_slope = 0.05;    // [-] plus this much per metre from the sensor (slopes, pitch)
+  double ground_max_grade = 0.1;     // [-] and at most this much per metre above the lowest
+                                     //     return around it (ground hidden behind an object)
   std::int64_t knot_us = 1000;       // [us] spacing of pose look-ups over the sweep
   std::int64_t max_points = 500000;  // [-] larger scans are refused as "huge_scan"
 
@@ -109,7 +116,7 @@ class Preprocessor {
   // interval by a look-up, not a division per return (the same quotients, computed once).
   std::vector<double> fraction_;
   // Ground grid.
-  std::vector<float> cell_min_, cell_ground_;
+  std::vector<float> cell_min_, cell_ground_, cell_bound_;
   std::vector<std::int32_t> point_cell_;
 };
 

@@ -183,6 +183,8 @@ bool TrackManagerParams::Validate(std::string* error) const {
              "contour_support_height", p.contour_support_height, "m", "in [0, 2]", error) ||
       !Check(p.contour_support_range > 0 && p.contour_support_range <= 2, "contour_support_range",
              p.contour_support_range, "m", "in (0, 2]", error) ||
+      !Check(p.contour_arc_span >= 0, "contour_arc_span", p.contour_arc_span, "m", ">= 0",
+             error) ||
       !Check(p.outline_min_slant_deg >= 0 && p.outline_min_slant_deg < 45,
              "outline_min_slant_deg", p.outline_min_slant_deg, "deg", "in [0, 45)", error) ||
       !Check(p.outline_min_points >= 3, "outline_min_points", p.outline_min_points, "", ">= 3",

@@ -283,16 +283,24 @@ bool Tracker::Process(const LadarScan& scan, bool forced, ScanOutput* out) {
         thin_.emplace_back(bin * (std::int64_t{1} << 32) + r2, static_cast<std::int32_t>(k));
       }
       std::sort(thin_.begin(), thin_.end());
-      thin_x_.clear();
-      thin_y_.clear();
       // 3-D clouds: the outline takes, per bin, the nearest return that stands on a vertical
       // face: another return of the bin lies within support_range of its range at a height
       // differing by support_height or more. A ring that grazes a horizontal surface (a roof,
       // a bonnet) hits it at a fixed distance from the sensor, so those returns move with the
       // ego vehicle; fitted as an edge they make a parked car look like a mover. Faces are hit
       // by several rings at nearly the same range.
-      const double support_h = multi_ring ? params_.manager.contour_support_height : 0.0;
+      //
+      // Unless no bin of the segment has such support and its returns lie at ranges spread over
+      // more than contour_arc_span: one ring seen over something nearer (the roof line of a car
+      // behind another), which a grazed roof or bonnet, at one range, cannot give. Then the
+      // nearest return per bin.
       const double support_r2 = params_.manager.contour_support_range;
+      auto range_of = [&](std::size_t a) {
+        return std::sqrt(static_cast<double>(thin_[a].first - FloorDiv32(thin_[a].first) * (std::int64_t{1} << 32)) * 1e-4);
+      };
+      thin_x_.clear();
+      thin_y_.clear();
+      auto outline = [&](double support_h) {
       std::size_t k = 0;
       while (k < thin_.size()) {
         std::size_t end = k + 1;
@@ -300,9 +308,6 @@ bool Tracker::Process(const LadarScan& scan, bool forced, ScanOutput* out) {
         std::size_t pick = k;
         if (support_h > 0.0) {
           pick = end;
-          auto range_of = [&](std::size_t a) {
-            return std::sqrt(static_cast<double>(thin_[a].first - FloorDiv32(thin_[a].first) * (std::int64_t{1} << 32)) * 1e-4);
-          };
           for (std::size_t a = k; a < end && pick == end; ++a) {
             const double ra = range_of(a);
             const float ha = points_.height[static_cast<std::size_t>(idx[static_cast<std::size_t>(thin_[a].second)])];
@@ -324,6 +329,16 @@ bool Tracker::Process(const LadarScan& scan, bool forced, ScanOutput* out) {
           thin_y_.push_back(ps.y[src]);
         }
         k = end;
+      }
+      };
+      outline(multi_ring ? params_.manager.contour_support_height : 0.0);
+      if (thin_x_.empty() && multi_ring && params_.manager.contour_support_height > 0.0) {
+        double r_lo = std::numeric_limits<double>::infinity(), r_hi = 0.0;
+        for (std::size_t a = 0; a < thin_.size(); ++a) {
+          r_lo = std::min(r_lo, range_of(a));
+          r_hi = std::max(r_hi, range_of(a));
+        }
+        if (r_hi - r_lo > params_.manager.contour_arc_span) outline(0.0);
       }
       ps.x.assign(thin_x_.begin(), thin_x_.end());
       ps.y.assign(thin_y_.begin(), thin_y_.end());

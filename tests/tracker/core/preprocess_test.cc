@@ -190,6 +190,98 @@ TEST(PreprocessTest, GridGroundRemovalKeepsObjectsAndDropsRoad) {
   EXPECT_GT(band_ground, 1000);
 }
 
+// A flat road seen everywhere except in the shadow of a nearer car (x 22-60 m, y -1.75 to 5.25),
+// and in that shadow only the upper edge of a far car, 1.4 m above the road, seen by one ring:
+// every cell around it holds only that edge.
+struct ShadowScene {
+  LadarScan scan;
+  std::vector<bool> is_car;  // per return
+  int num_car = 0;
+};
+
+ShadowScene RoofLineInAShadow() {
+  ShadowScene s;
+  s.scan.utime = kT0;
+  s.scan.sweep_duration_us = 100'000;
+  s.scan.num_rings = 64;
+  s.scan.body_from_sensor.translation() = Eigen::Vector3d(0, 0, 1.7);
+  auto add = [&](double bx, double by, double bz, bool car) {
+    s.scan.x.push_back(static_cast<float>(bx));
+    s.scan.y.push_back(static_cast<float>(by));
+    s.scan.z.push_back(static_cast<float>(bz - 1.7));
+    s.scan.dt_us.push_back(0);
+    s.scan.ring.push_back(0);
+    s.scan.intensity.push_back(0.0f);
+    s.is_car.push_back(car);
+    s.num_car += car;
+  };
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-60.0, 60.0), noise(-0.02, 0.02);
+  for (int i = 0; i < 40000; ++i) {
+    const double x = u(rng), y = u(rng);
+    if (x > 22.0 && y > -1.75 && y < 5.25) continue;  // the shadow
+    add(x, y, noise(rng), false);
+  }
+  for (double y = 0.85; y <= 2.65 + 1e-9; y += 0.1) add(31.75, y, 1.4, true);
+  for (double x = 31.85; x <= 36.25 + 1e-9; x += 0.1) add(x, 0.85, 1.4, true);
+  return s;
+}
+
+TEST(PreprocessTest, GroundUnderAFarCarsRoofLineIsBoundedByTheRoadAroundIt) {
+  PoseHistory poses(10'000'000);
+  poses.Add(kT0 - 10'000, Eigen::Isometry3d::Identity());
+  poses.Add(kT0 + 200'000, Eigen::Isometry3d::Identity());
+  const ShadowScene scene = RoofLineInAShadow();
+  auto kept = [&](const PreprocessParams& params, int* road) {
+    Preprocessor pre(params);
+    WorldPoints out;
+    pre.Run(scene.scan, poses, 0, &out);
+    int car = 0;
+    *road = 0;
+    for (std::size_t k = 0; k < out.size(); ++k) {
+      (scene.is_car[static_cast<std::size_t>(out.index[k])] ? car : *road)++;
+    }
+    return car;
+  };
+  int road = 0;
+  // The road 2.6 m or more beside the edge bounds the ground under it: 0.6 m (the tolerance),
+  // not the edge's own 1.4 m. Every return of the edge is kept, none of the road.
+  EXPECT_EQ(kept(PreprocessParams{}, &road), scene.num_car);
+  EXPECT_EQ(road, 0);
+  // With no bound from the road around (any grade allowed), the lowest return near the edge
+  // is the edge itself, and it is removed as ground.
+  PreprocessParams unbounded;
+  unbounded.ground_max_grade = 10.0;
+  EXPECT_EQ(kept(unbounded, &road), 0);
+}
+
+TEST(PreprocessTest, LowOutlierDoesNotLowerTheGroundBeyondItsNeighbours) {
+  PoseHistory poses(10'000'000);
+  poses.Add(kT0 - 10'000, Eigen::Isometry3d::Identity());
+  poses.Add(kT0 + 200'000, Eigen::Isometry3d::Identity());
+  ShadowScene s = RoofLineInAShadow();
+  // A return 1.5 m under the road at (-20.5, 10.5), as a reflection in a puddle gives.
+  s.scan.x.push_back(-20.5f);
+  s.scan.y.push_back(10.5f);
+  s.scan.z.push_back(-1.5f - 1.7f);
+  s.scan.dt_us.push_back(0);
+  s.scan.ring.push_back(0);
+  s.scan.intensity.push_back(0.0f);
+  s.is_car.push_back(false);
+  Preprocessor pre(PreprocessParams{});
+  WorldPoints out;
+  pre.Run(s.scan, poses, 0, &out);
+  // The grid's 3x3 neighbourhood of the outlier's cell may keep road returns (as before); the
+  // bound of the cells farther away comes into play only where the ground would lie more than
+  // the tolerance above the scan's level, so no road return farther away is kept.
+  int far_road = 0;
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    if (s.is_car[static_cast<std::size_t>(out.index[k])]) continue;
+    if (std::max(std::abs(out.x[k] + 20.5), std::abs(out.y[k] - 10.5)) > 2.0) ++far_road;
+  }
+  EXPECT_EQ(far_road, 0);
+}
+
 TEST(PreprocessTest, ValidateNamesTheKeyAndValue) {
   PreprocessParams p;
   std::string error;

@@ -145,6 +145,10 @@ struct FitRequest {
   double width_std_m = 0.0;   // [m] 1-sigma uncertainty of width_m, >= 0
   bool shape_known = false;
   std::optional<double> predicted_theta;  // [rad] track's predicted heading; empty: new object
+  // [m] track's predicted centre, in the frame of x and y; empty: new object. A single face seen
+  // in part is placed along itself at this centre if the seen part lies on the predicted face;
+  // otherwise, and if empty, at the seen part's middle.
+  std::optional<Eigen::Vector2d> predicted_center;
   double range_sigma_m = 0.03;            // [m] LADAR range noise (1 sigma), > 0
   double min_inside_fraction = 0.0;       // [-] in [0, 1]: share of points inside the rectangle
   std::uint64_t seed = 0;                 // RANSAC sampling; equal requests give equal results

@@ -323,7 +323,7 @@ bool TrackManager::SmallObject(const PointSet& points) const {
 bool TrackManager::Measure(const Track& t, TrackHypothesis* h, const PointSet& points,
                            const Eigen::Vector2d& sensor_xy, std::uint64_t seed,
                            std::optional<double> predicted_theta, bool small,
-                           CentreMeasurement* m) {
+                           CentreMeasurement* m, std::optional<Eigen::Vector2d> predicted_center) {
   h->has_fit = false;
   if (small) {
     // Centroid measurement of a small object (pole, bush, pedestrian): no rectangle to fit.
@@ -347,6 +347,7 @@ bool TrackManager::Measure(const Track& t, TrackHypothesis* h, const PointSet& p
   req.length_std_m = req.shape_known ? 0.1 : params_.default_dimension_std;
   req.width_std_m = req.shape_known ? 0.1 : params_.default_dimension_std;
   req.predicted_theta = predicted_theta;
+  if (predicted_center) req.predicted_center = *predicted_center - points.origin;
   req.range_sigma_m = params_.range_sigma;
   req.min_inside_fraction = h->inside_fraction;
   req.seed = seed;
@@ -411,6 +412,10 @@ void TrackManager::Update(std::size_t index, const PointSet& points,
   }
 
   bool any = false;
+  // A parked car's partial face is placed along itself where predicted (FitRequest::
+  // predicted_center). Not a mover's: measured against KITTI 0000 with movers too, HOTA fell in
+  // every mode (mht 0.442 -> 0.400); the same view of a mover does not repeat scan after scan.
+  const bool parked = Parked(t);
   for (std::size_t k = 0; k < t.hyps.size(); ++k) {
     TrackHypothesis& h = t.hyps[k];
     h.updated_this_scan = false;
@@ -420,7 +425,8 @@ void TrackManager::Update(std::size_t index, const PointSet& points,
     double term = 0.5 * (ekf_.gate_nis() + h.last_logdet);
     // Same request for every hypothesis but the heading and the shape: the seed is shared so
     // hypotheses that agree get the same fit.
-    if (Measure(t, &h, points, sensor_xy, seed, pose(2), t.small_object, &m)) {
+    if (Measure(t, &h, points, sensor_xy, seed, pose(2), t.small_object, &m,
+                parked ? std::optional<Eigen::Vector2d>(pose.head<2>()) : std::nullopt)) {
       const auto idx = model.PoseIndices();
       Eigen::Matrix3d S;
       for (int r = 0; r < 3; ++r)

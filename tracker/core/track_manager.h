@@ -313,7 +313,8 @@ class TrackManager {
   void Dimensions(const Track& t, const TrackHypothesis& h, double* length, double* width) const;
   bool Measure(const Track& t, TrackHypothesis* h, const PointSet& points,
                const Eigen::Vector2d& sensor_xy, std::uint64_t seed,
-               std::optional<double> predicted_theta, bool small, CentreMeasurement* m);
+               std::optional<double> predicted_theta, bool small, CentreMeasurement* m,
+               std::optional<Eigen::Vector2d> predicted_center = std::nullopt);
   void Select(Track* t) const;
   void Reseed(Track* t) const;
   void TestMotion(Track* t);

@@ -920,5 +920,45 @@ TEST(Fitting, FarFromTheWorldOrigin) {
   EXPECT_LT(Nees(fit, truth), 20.0);
 }
 
+// A car of known shape (4.5 x 1.8 m, heading 0, centre (20, 10)) of which only 0.9 m of the side
+// facing the sensor is seen (x 18.0-18.9: the rest hidden). Where along the side that part lies
+// is not measured: with the track's predicted centre, z keeps the prediction along the side as
+// long as the seen part fits on the predicted face; else (and without a prediction) the part's
+// middle, as before.
+TEST(Fitting, PartialFaceKeepsThePredictedPositionAlongItself) {
+  std::vector<float> x, y;
+  for (double px = 18.0; px <= 18.9 + 1e-9; px += 0.05) {
+    x.push_back(static_cast<float>(px));
+    y.push_back(9.1f);
+  }
+  FitRequest req;
+  req.x = x;
+  req.y = y;
+  req.sensor_xy = Eigen::Vector2d(20.0, 0.0);
+  req.length_m = 4.5;
+  req.width_m = 1.8;
+  req.shape_known = true;
+  req.predicted_theta = 0.0;
+  SegmentFitter fitter;
+  FitResult fit;
+
+  fitter.Fit(req, &fit);
+  ASSERT_EQ(fit.kind, FitKind::kEdge) << ToString(fit.failure);
+  const double middle = fit.z.x();
+  EXPECT_NEAR(middle, 18.45, 0.1);  // no prediction: the seen part's middle
+  EXPECT_NEAR(fit.z.y(), 10.0, 0.05);
+
+  req.predicted_center = Eigen::Vector2d(20.0, 10.0);  // the part lies on the predicted face
+  fitter.Fit(req, &fit);
+  ASSERT_EQ(fit.kind, FitKind::kEdge) << ToString(fit.failure);
+  EXPECT_NEAR(fit.z.x(), 20.0, 1e-6);
+  EXPECT_NEAR(fit.z.y(), 10.0, 0.05);
+
+  req.predicted_center = Eigen::Vector2d(22.0, 10.0);  // face 19.75-24.25: the part is off it
+  fitter.Fit(req, &fit);
+  ASSERT_EQ(fit.kind, FitKind::kEdge) << ToString(fit.failure);
+  EXPECT_NEAR(fit.z.x(), middle, 1e-6);
+}
+
 }  // namespace
 }  // namespace vtrack

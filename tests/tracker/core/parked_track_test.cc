@@ -85,5 +85,47 @@ TEST(ParkedTrackTest, MissedParkedTrackIsLookedForWhereItWasWithoutGateGrowthAnd
   EXPECT_LE(static_cast<double>(t - last_update) * 1e-6, params.parked_coast_max_s + 0.15);
 }
 
+// The west 0.9 m of the same car's side, the rest hidden (a car passing in front): where along
+// the side that piece lies is not measured, so the same view scan after scan must not move the
+// parked car's track along its side (its middle, 2.45 m west of the car's centre, did: the track
+// slid at up to 1.4 m/s).
+PointSet HiddenButForTheSidesWestEnd(std::int64_t utime) {
+  PointSet p;
+  p.origin = Eigen::Vector2d(20.0, 5.0);
+  for (double x = 17.85; x <= 18.75 + 1e-9; x += 0.05) {
+    p.x.push_back(static_cast<float>(x - 20.0));
+    p.y.push_back(static_cast<float>(4.1 - 5.0));
+  }
+  p.mean_utime = utime;
+  p.extent = 0.9;
+  return p;
+}
+
+TEST(ParkedTrackTest, PartialViewOfAParkedCarKeepsItsTrackInPlace) {
+  const Ekf ekf;
+  const TrackManagerParams params;
+  TrackManager m(params, ekf, FitParams(), ShapeParams());
+  const Eigen::Vector2d sensor(0.0, 0.0);
+  std::int64_t t = 1'000'000'000;
+  ASSERT_TRUE(m.Create(ParkedCorner(t), sensor, 1));
+  m.EndScan(t);
+  for (int k = 1; k <= 20; ++k) {
+    t += kStep;
+    m.Update(0, ParkedCorner(t), sensor, static_cast<std::uint64_t>(k), nullptr);
+    m.EndScan(t);
+  }
+  ASSERT_EQ(m.tracks().size(), 1u);
+  ASSERT_FALSE(m.tracks()[0].mover);
+  for (int k = 21; k <= 50; ++k) {  // 3 s of the partial view
+    t += kStep;
+    m.Update(0, HiddenButForTheSidesWestEnd(t), sensor, static_cast<std::uint64_t>(k), nullptr);
+    m.EndScan(t);
+  }
+  ASSERT_EQ(m.tracks().size(), 1u);
+  const OrientedBox box = m.Box(0);
+  EXPECT_NEAR(box.center.x(), 20.0, 0.3);
+  EXPECT_NEAR(box.center.y(), 5.0, 0.3);
+}
+
 }  // namespace
 }  // namespace vtrack

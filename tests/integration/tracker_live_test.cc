@@ -182,11 +182,12 @@ TEST(TrackerLiveTest, UrbanIntersectionLiveWith64LayerScans) {
   }
   for (const auto& m : r.switches) std::printf("  switch %s\n", m.c_str());
   // Issue 5 asks for every due vehicle tracked and no identity switch. On this lap: no identity
-  // switch, 99.4% of due (vehicle, scan) pairs tracked (2155 of 2169) with every scan processed;
-  // the misses left are a passing car hidden behind others and an oncoming car whose returns at
-  // 33-40 m the ground grid removes (tracker/README.md, open issues). Asserted: no switch when
-  // every scan reached the tracker (at most one if the bus lost some), and 98.5% of the pairs.
-  EXPECT_GE(r.matched * 1000, r.due * 985) << (r.misses.empty() ? "" : r.misses.front());
+  // switch, 99.6% of due (vehicle, scan) pairs tracked (2161 of 2169) with every scan processed;
+  // the misses left are a passing car seen by 1-4 returns for its first second behind others, a
+  // parked car's end face at 40 m and one scan of a lot car (tracker/README.md, open issues).
+  // Asserted: no switch when every scan reached the tracker (at most one if the bus lost some),
+  // and 99.0% of the pairs.
+  EXPECT_GE(r.matched * 1000, r.due * 990) << (r.misses.empty() ? "" : r.misses.front());
   EXPECT_LE(r.id_switches, st.scans_processed >= 119 ? 0 : 1)
       << (r.switches.empty() ? "" : r.switches.front());
   EXPECT_EQ(r.max_hyps_not_moving, 1);

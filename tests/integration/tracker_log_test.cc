@@ -139,13 +139,14 @@ TEST_F(TrackerLogTest, UrbanIntersectionStationaryObjectsHoldOneHypothesisMovers
   // hypothesis (no parked car is judged a mover).
   EXPECT_EQ(r.max_hyps_stationary_truth, 1)
       << (r.stationary_multi.empty() ? "" : r.stationary_multi.front());
-  // Quality on this lap, offline (deterministic): measured 99.4% of due (vehicle, scan) pairs
-  // tracked (2155 of 2169) and no identity switch; issue 5 asks for all pairs and no switch: the
-  // misses left are a passing car hidden behind others and an oncoming car whose returns at
-  // 33-40 m the ground grid removes (tracker/README.md, open issues).
+  // Quality on this lap, offline (deterministic): measured 99.6% of due (vehicle, scan) pairs
+  // tracked (2161 of 2169) and no identity switch; issue 5 asks for all pairs and no switch: the
+  // misses left are a passing car seen by 1-4 returns for its first second behind others, a
+  // parked car's end face at 40 m tracked at the face, and one scan of a lot car
+  // (tracker/README.md, open issues).
   for (const auto& m : r.misses) std::printf("  %s\n", m.c_str());
   for (const auto& m : r.switches) std::printf("  switch %s\n", m.c_str());
-  EXPECT_GE(r.matched * 1000, r.due * 990) << (r.misses.empty() ? "" : r.misses.front());
+  EXPECT_GE(r.matched * 1000, r.due * 995) << (r.misses.empty() ? "" : r.misses.front());
   EXPECT_EQ(r.id_switches, 0) << (r.switches.empty() ? "" : r.switches.front());
   std::filesystem::remove(sim);                    // 300 MB
 }

@@ -177,6 +177,8 @@ void Read(const YAML::Node& root, const std::string& origin, TrackerParams* p) {
     s.Get("join_max_gap", &q.join_max_gap);
     s.Get("join_max_deg", &q.join_max_deg);
     s.Get("join_max_extent", &q.join_max_extent);
+    s.Get("mover_max_length", &q.mover_max_length);
+    s.Get("mover_column_width", &q.mover_column_width);
     s.Done();
   }
   {

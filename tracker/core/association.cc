@@ -99,6 +99,9 @@ std::string AssociationParams::FirstProblem() const {
     return Bad("min_inside_fraction", min_inside_fraction, "must be in (0, 1]");
   if (!(outside_penalty >= 0.0)) return Bad("outside_penalty", outside_penalty, "must be >= 0");
   if (!(miss_cost > 0.0)) return Bad("miss_cost", miss_cost, "must be > 0");
+  if (!(mover_max_length >= 0.0)) return Bad("mover_max_length", mover_max_length, "must be >= 0");
+  if (!(mover_column_width >= 0.0))
+    return Bad("mover_column_width", mover_column_width, "must be >= 0");
   if (!(merge_fraction > 0.0 && merge_fraction <= 1.0))
     return Bad("merge_fraction", merge_fraction, "must be in (0, 1]");
   if (!(ignore_max_extent >= 0.0 && ignore_max_extent <= 10.0))
@@ -485,6 +488,61 @@ void Associator::BuildParts(const std::vector<PredictedObject>& tracks, const Wo
   }
 }
 
+bool Associator::JoinMover(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
+                           const Eigen::Vector2d& sensor_xy, const std::vector<std::int32_t>& piece,
+                           AssociationResult* out, std::vector<char>* own_valid) const {
+  if (piece.empty() || !(params_.mover_max_length > 0.0)) return false;
+  // Across the ray: a side seen edge-on is a line along the ray; a following car shows its front.
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const std::int32_t i : piece) {
+    mean += Eigen::Vector2d(pts.x[static_cast<std::size_t>(i)], pts.y[static_cast<std::size_t>(i)]);
+  }
+  mean /= static_cast<double>(piece.size());
+  const Eigen::Vector2d ray = (mean - sensor_xy).normalized();
+  double across_lo = kInf, across_hi = -kInf;
+  for (const std::int32_t i : piece) {
+    const Eigen::Vector2d d(pts.x[static_cast<std::size_t>(i)] - mean.x(), pts.y[static_cast<std::size_t>(i)] - mean.y());
+    const double a = -ray.y() * d.x() + ray.x() * d.y();
+    across_lo = std::min(across_lo, a);
+    across_hi = std::max(across_hi, a);
+  }
+  if (across_hi - across_lo > params_.mover_column_width) return false;
+  for (std::size_t j = 0; j < tracks.size(); ++j) {
+    const PredictedObject& t = tracks[j];
+    if (t.rear_sign == 0 || out->track_points[j].empty()) continue;
+    const BoxFrame frame(t.box);
+    const double hl = 0.5 * t.box.length, hw = 0.5 * t.box.width + params_.gate_margin;
+    // The front end stays; the box reaches back to mover_max_length.
+    const double front = -t.rear_sign * hl;
+    bool inside = true;
+    double lo = kInf, hi = -kInf;
+    auto extend = [&](const Eigen::Vector2d& p) {
+      lo = std::min(lo, p.x());
+      hi = std::max(hi, p.x());
+    };
+    for (const std::int32_t i : piece) {
+      const Eigen::Vector2d p = frame.To(pts.x[static_cast<std::size_t>(i)], pts.y[static_cast<std::size_t>(i)]);
+      const double back = t.rear_sign * (p.x() - front);  // distance behind the front end
+      if (std::abs(p.y()) > hw || back < 0.0 || back > params_.mover_max_length) {
+        inside = false;
+        break;
+      }
+      extend(p);
+    }
+    if (!inside) continue;
+    for (const std::int32_t i : out->track_points[j]) {
+      extend(frame.To(pts.x[static_cast<std::size_t>(i)], pts.y[static_cast<std::size_t>(i)]));
+    }
+    if (hi - lo > params_.mover_max_length + params_.gate_margin) continue;
+    auto& dst = out->track_points[j];
+    dst.insert(dst.end(), piece.begin(), piece.end());
+    (*own_valid)[j] = 0;
+    ++out->num_merged;
+    return true;
+  }
+  return false;
+}
+
 void Associator::Run(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
                      const Segments& segments, const Eigen::Vector2d& sensor_xy,
                      AssociationResult* out) {
@@ -694,7 +752,7 @@ void Associator::Run(const std::vector<PredictedObject>& tracks, const WorldPoin
       // column of returns off a side seen at a grazing angle), but not merged: not a new object
       // (it would seed a duplicate of that track), not a measurement.
       ++out->num_ignored;
-    } else {
+    } else if (!JoinMover(tracks, pts, sensor_xy, parts_[q].points, out, &own_valid)) {
       // A larger piece only inside the grown gate of a track (its position uncertainty):
       // another object.
       out->new_objects.push_back(std::move(parts_[q].points));

@@ -58,6 +58,10 @@ struct AssociationParams {
   double join_max_gap = 2.5;         // [m] centroid distance of two pieces
   double join_max_deg = 10.0;        // [deg] angle between the line of two pieces and the ray
   double join_max_extent = 5.0;      // [m] bounding-box diagonal of the joined segment
+  // Columns behind a mover (PredictedObject::rear_sign): across the ray at most
+  // mover_column_width, and the mover with them at most mover_max_length long.
+  double mover_max_length = 12.0;    // [m]
+  double mover_column_width = 0.5;   // [m]
 
   // True if every field is valid; otherwise false and *error names the key and its value.
   bool Validate(std::string* error) const;
@@ -74,6 +78,11 @@ struct PredictedObject {
   // 0: unknown (the box bounds them).
   double seen_length = 0.0;          // [m]
   double seen_width = 0.0;           // [m]
+  // A mover's rear end, +1 or -1 along the box's x axis (against its motion); 0: not a mover.
+  // A leftover column of returns along the ray, within the mover's width behind it, is its own
+  // side seen edge-on (a long vehicle coming head-on): it joins the mover up to
+  // AssociationParams::mover_max_length.
+  int rear_sign = 0;
 };
 
 struct AssociationResult {
@@ -140,6 +149,10 @@ class Associator {
     void Overlapping(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi,
                      std::vector<std::int32_t>* ids) const;
   };
+  // A leftover piece joining a mover as its side seen edge-on (PredictedObject::rear_sign).
+  bool JoinMover(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
+                 const Eigen::Vector2d& sensor_xy, const std::vector<std::int32_t>& piece,
+                 AssociationResult* out, std::vector<char>* own_valid) const;
   void BuildParts(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
                   const Segments& segments);
   // Cost of (track, part), or +inf if the part is not a candidate of the track.

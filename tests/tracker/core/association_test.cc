@@ -303,6 +303,49 @@ TEST(JoinGrazingPiecesTest, PiecesSideBySideAcrossTheRayOrTooFarApartStaySeparat
   EXPECT_EQ(s.segments.segments.size(), n);
 }
 
+// An 8 x 2.5 m truck coming head-on (centre (-1.75, 44), heading -90 deg) seen from the origin:
+// its front face (y = 40) and, behind it, its side edge-on (x = -0.5) as columns of two returns
+// along the ray. Its track has the default 4.5 m length. The columns within 12 m of the front
+// are the truck's own side and join its track; a column beyond, and the front face of a car
+// following it (across the ray), are new objects. Without a mover the columns are new objects.
+TEST(AssociatorTest, SideOfALongMoverSeenEdgeOnJoinsIt) {
+  const Eigen::Vector2d sensor(0, 0);
+  WorldPoints pts;
+  auto add = [&](double x, double y) {
+    pts.push_back(x, y, 1.0f, static_cast<std::int32_t>(pts.size()), 0);
+  };
+  for (int i = 0; i <= 25; ++i) add(-3.0 + 0.1 * i, 40.0);  // front face: 26 returns
+  const int front = static_cast<int>(pts.size());
+  add(-0.5, 46.5);  // side columns behind the front
+  add(-0.5, 46.8);
+  add(-0.5, 48.5);
+  add(-0.5, 48.9);
+  const int columns = static_cast<int>(pts.size());
+  add(-0.5, 53.0);  // 13 m behind the front
+  add(-0.5, 53.4);
+  const int far = static_cast<int>(pts.size());
+  for (int i = 0; i <= 18; ++i) add(-2.6 + 0.1 * i, 50.0);  // a following car's front face
+  const Segments segs = SegmentsOf(
+      pts, {{0, front}, {front, front + 2}, {front + 2, columns}, {columns, far},
+            {far, static_cast<int>(pts.size())}});
+  PredictedObject truck = Pred(-1.75, 42.25, -kPi / 2);
+  truck.box.width = 2.5;
+  truck.rear_sign = -1;  // box x points along the motion (-y): the rear is at -x
+  Associator assoc(AssociationParams{});
+  AssociationResult res;
+  assoc.Run({truck}, pts, segs, sensor, &res);
+  EXPECT_EQ(static_cast<int>(res.track_points[0].size()), columns);
+  EXPECT_EQ(res.num_merged, 2);
+  ASSERT_EQ(res.new_objects.size(), 2u);
+  EXPECT_EQ(res.new_objects[0].front(), columns);
+  EXPECT_EQ(res.new_objects[1].front(), far);
+
+  truck.rear_sign = 0;  // not a mover
+  assoc.Run({truck}, pts, segs, sensor, &res);
+  EXPECT_EQ(static_cast<int>(res.track_points[0].size()), front);
+  EXPECT_EQ(res.new_objects.size(), 4u);
+}
+
 TEST(AssociatorTest, ValidateNamesTheKey) {
   AssociationParams p;
   std::string error;

@@ -510,6 +510,12 @@ bool Associator::JoinMover(const std::vector<PredictedObject>& tracks, const Wor
   for (std::size_t j = 0; j < tracks.size(); ++j) {
     const PredictedObject& t = tracks[j];
     if (t.rear_sign == 0 || out->track_points[j].empty()) continue;
+    // Its side is seen edge-on only if its axis lies near the ray (within join_max_deg x 2):
+    // behind a crossing mover the band would be a strip across the ray, a pedestrian's place.
+    if (std::abs(std::cos(t.box.theta) * ray.x() + std::sin(t.box.theta) * ray.y()) <
+        std::cos(2.0 * DegToRad(params_.join_max_deg))) {
+      continue;
+    }
     const BoxFrame frame(t.box);
     const double hl = 0.5 * t.box.length, hw = 0.5 * t.box.width + params_.gate_margin;
     // The front end stays; the box reaches back to mover_max_length.

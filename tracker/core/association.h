@@ -58,8 +58,9 @@ struct AssociationParams {
   double join_max_gap = 2.5;         // [m] centroid distance of two pieces
   double join_max_deg = 10.0;        // [deg] angle between the line of two pieces and the ray
   double join_max_extent = 5.0;      // [m] bounding-box diagonal of the joined segment
-  // Columns behind a mover (PredictedObject::rear_sign): across the ray at most
-  // mover_column_width, and the mover with them at most mover_max_length long.
+  // Columns behind a mover (PredictedObject::rear_sign) whose axis lies within 2 x join_max_deg
+  // of the ray: across the ray at most mover_column_width, and the mover with them at most
+  // mover_max_length long.
   double mover_max_length = 12.0;    // [m]
   double mover_column_width = 0.5;   // [m]
 

@@ -682,6 +682,9 @@ void CheckRequest(const FitRequest& r) {
     os << "FitRequest.width_std_m = " << r.width_std_m << ": must be >= 0";
   } else if (r.predicted_theta && !std::isfinite(*r.predicted_theta)) {
     os << "FitRequest.predicted_theta = " << *r.predicted_theta << ": must be finite";
+  } else if (r.predicted_center && !r.predicted_center->allFinite()) {
+    os << "FitRequest.predicted_center = (" << r.predicted_center->x() << ", "
+       << r.predicted_center->y() << "): must be finite";
   } else if (!(r.range_sigma_m > 0.0 && std::isfinite(r.range_sigma_m))) {
     os << "FitRequest.range_sigma_m = " << r.range_sigma_m << ": must be > 0";
   } else if (!(r.min_inside_fraction >= 0.0 && r.min_inside_fraction <= 1.0)) {
@@ -772,7 +775,10 @@ FitFailure Measure(const Context& ctx, const FitRequest& req, const FitParams& p
       // corrected outwards) lies on the predicted face; else, the part's middle as before.
       // Tried: moving the centre just far enough to hold the part if it sticks out by up to
       // 0.25-1 m: urban laps went from 1 to 9 identity switches (a parked car whose corner fit
-      // takes the wrong axis got a second track), tracker/README.md.
+      // takes the wrong axis got a second track), tracker/README.md. The variance along the face
+      // stays the paper's (below): the filter still grows too sure of the position along a face
+      // it sees only in part over many scans, as with the middle before; the mean is no longer
+      // pulled.
       const double half = 0.5 * D_face_used;
       const double s_pred = u0.dot(*req.predicted_center - ctx.origin - m.c);
       if (s_pred >= hi - half && s_pred <= lo + half) along_mid = m.c + u0 * s_pred;

@@ -11,8 +11,10 @@
 //     to within ground_tolerance + ground_max_slope * distance of the scan's overall ground
 //     level ("grid"), which follows slopes and any sensor mounting height without
 //     configuration. The clamp keeps a cell that sees only a roof from being taken as ground.
-//     Nearer the sensor that clamp is loose (2.25 m at 33 m), so the local ground is also kept
-//     below the lowest return of every other cell plus ground_max_grade per metre between them:
+//     Far from the sensor that clamp is loose (2.25 m at 33 m), so where the local ground lies
+//     more than ground_tolerance above the scan's level it is also kept below the lowest return
+//     of every other cell plus ground_max_grade per metre between them (but not below that
+//     tolerance: a single low outlier must not pull down the ground of the cells around it):
 //     a car whose lower part another vehicle hides shows only its roof line, the ground around
 //     it is unseen, and the lowest return of its cells is that roof line; the road seen beside
 //     or in front of it bounds its ground instead.

@@ -307,9 +307,10 @@ void TrackManager::Predict(std::int64_t utime, std::vector<PredictedObject>* out
     p.seen_length = sel.length_est.value_or(0.0);
     p.seen_width = sel.width_est.value_or(0.0);
     if (t.mover) {
+      // Its rear is known only while it moves (a mover stopped at a light keeps the flag).
       const CentreEstimate c = ekf_.Centre(h);
       const Eigen::Vector2d axis(std::cos(p.box.theta), std::sin(p.box.theta));
-      p.rear_sign = c.velocity.dot(axis) >= 0.0 ? -1 : 1;
+      if (c.speed >= params_.mover_min_speed) p.rear_sign = c.velocity.dot(axis) >= 0.0 ? -1 : 1;
     }
     out->push_back(p);
   }

@@ -115,8 +115,9 @@ struct TrackManagerParams {
   // (it stands on a vertical face; roofs and bonnets are grazed by single rings). 0: off.
   double contour_support_height = 0.1;      // [m]
   double contour_support_range = 0.25;      // [m]
-  // ... unless no return of a segment has that support and their ranges span more than this:
-  // one ring over a nearer object sees the top of a face, a grazed roof lies at one range.
+  // ... unless no return of a segment has that support and the returns of one ring span at
+  // least this much range: one ring over a nearer object sees the top of a face, while a ring
+  // grazing a roof or bonnet hits it at one range (0: any unsupported segment).
   double contour_arc_span = 1.0;            // [m]
   // 3-D clouds: the fit on that outline refuses faces seen at less than outline_min_slant_deg
   // and needs outline_min_points points and outline_min_edge_inliers on an edge (the fit's own

@@ -333,12 +333,25 @@ bool Tracker::Process(const LadarScan& scan, bool forced, ScanOutput* out) {
       };
       outline(multi_ring ? params_.manager.contour_support_height : 0.0);
       if (thin_x_.empty() && multi_ring && params_.manager.contour_support_height > 0.0) {
-        double r_lo = std::numeric_limits<double>::infinity(), r_hi = 0.0;
+        // The span of one ring: rings grazing a bonnet and a roof hit them at different ranges,
+        // each at its own one range.
+        ring_span_.clear();
+        double span = 0.0;
         for (std::size_t a = 0; a < thin_.size(); ++a) {
-          r_lo = std::min(r_lo, range_of(a));
-          r_hi = std::max(r_hi, range_of(a));
+          const auto i = static_cast<std::size_t>(idx[static_cast<std::size_t>(thin_[a].second)]);
+          const std::int16_t ring = points_.ring[i];
+          const double r = range_of(a);
+          auto it = std::find_if(ring_span_.begin(), ring_span_.end(),
+                                 [&](const RingSpan& e) { return e.ring == ring; });
+          if (it == ring_span_.end()) {
+            ring_span_.push_back({ring, r, r});
+          } else {
+            it->lo = std::min(it->lo, r);
+            it->hi = std::max(it->hi, r);
+            span = std::max(span, it->hi - it->lo);
+          }
         }
-        if (r_hi - r_lo > params_.manager.contour_arc_span) outline(0.0);
+        if (span >= params_.manager.contour_arc_span) outline(0.0);
       }
       ps.x.assign(thin_x_.begin(), thin_x_.end());
       ps.y.assign(thin_y_.begin(), thin_y_.end());

@@ -105,6 +105,11 @@ class Tracker {
   RangeProfile profile_;  // nearest return per bearing of the scan being processed
   std::vector<std::pair<std::int64_t, std::int32_t>> thin_;
   std::vector<float> thin_x_, thin_y_;
+  struct RingSpan {
+    std::int16_t ring;
+    double lo, hi;  // [m] range of the ring's returns in a segment
+  };
+  std::vector<RingSpan> ring_span_;
 
   std::int64_t latest_utime_ = 0;
   bool have_time_ = false;

@@ -87,8 +87,8 @@ TEST(ParkedTrackTest, MissedParkedTrackIsLookedForWhereItWasWithoutGateGrowthAnd
 
 // The west 0.9 m of the same car's side, the rest hidden (a car passing in front): where along
 // the side that piece lies is not measured, so the same view scan after scan must not move the
-// parked car's track along its side (its middle, 2.45 m west of the car's centre, did: the track
-// slid at up to 1.4 m/s).
+// parked car's track along its side (its middle, 1.7 m west of the car's centre, pulled it: the
+// track ended 1.9 m west without the rule).
 PointSet HiddenButForTheSidesWestEnd(std::int64_t utime) {
   PointSet p;
   p.origin = Eigen::Vector2d(20.0, 5.0);

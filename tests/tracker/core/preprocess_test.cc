@@ -255,29 +255,44 @@ TEST(PreprocessTest, GroundUnderAFarCarsRoofLineIsBoundedByTheRoadAroundIt) {
   EXPECT_EQ(kept(unbounded, &road), 0);
 }
 
-TEST(PreprocessTest, LowOutlierDoesNotLowerTheGroundBeyondItsNeighbours) {
+TEST(PreprocessTest, LowOutliersDoNotLowerTheGroundBeyondTheirNeighbours) {
   PoseHistory poses(10'000'000);
   poses.Add(kT0 - 10'000, Eigen::Isometry3d::Identity());
   poses.Add(kT0 + 200'000, Eigen::Isometry3d::Identity());
   ShadowScene s = RoofLineInAShadow();
-  // A return 1.5 m under the road at (-20.5, 10.5), as a reflection in a puddle gives.
-  s.scan.x.push_back(-20.5f);
-  s.scan.y.push_back(10.5f);
-  s.scan.z.push_back(-1.5f - 1.7f);
-  s.scan.dt_us.push_back(0);
-  s.scan.ring.push_back(0);
-  s.scan.intensity.push_back(0.0f);
-  s.is_car.push_back(false);
+  // Returns 1.5 m under the road, as reflections in puddles give: one on the open road at
+  // (-20.5, 10.5), one in the shadow 1.85 m beside the far car's roof line (34.5, 4.5).
+  for (const auto& [x, y] : {std::pair{-20.5f, 10.5f}, std::pair{34.5f, 4.5f}}) {
+    s.scan.x.push_back(x);
+    s.scan.y.push_back(y);
+    s.scan.z.push_back(-1.5f - 1.7f);
+    s.scan.dt_us.push_back(0);
+    s.scan.ring.push_back(0);
+    s.scan.intensity.push_back(0.0f);
+    s.is_car.push_back(false);
+  }
   Preprocessor pre(PreprocessParams{});
   WorldPoints out;
   pre.Run(s.scan, poses, 0, &out);
-  // The grid's 3x3 neighbourhood of the outlier's cell may keep road returns (as before); the
+  // The roof line's ground stays at the tolerance (0.6 m), not at the outlier's bound
+  // (-1.5 + 0.1 x 1.85 m): its returns stand 0.8 m above it.
+  int car = 0;
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    if (!s.is_car[static_cast<std::size_t>(out.index[k])]) continue;
+    ++car;
+    EXPECT_NEAR(out.height[k], 0.8, 0.02);
+  }
+  EXPECT_EQ(car, s.num_car);
+  // The grid's 3x3 neighbourhood of an outlier's cell may keep road returns (as before); the
   // bound of the cells farther away comes into play only where the ground would lie more than
   // the tolerance above the scan's level, so no road return farther away is kept.
   int far_road = 0;
   for (std::size_t k = 0; k < out.size(); ++k) {
     if (s.is_car[static_cast<std::size_t>(out.index[k])]) continue;
-    if (std::max(std::abs(out.x[k] + 20.5), std::abs(out.y[k] - 10.5)) > 2.0) ++far_road;
+    const bool near_outlier =
+        std::max(std::abs(out.x[k] + 20.5), std::abs(out.y[k] - 10.5)) <= 2.0 ||
+        std::max(std::abs(out.x[k] - 34.5), std::abs(out.y[k] - 4.5)) <= 2.0;
+    far_road += !near_outlier;
   }
   EXPECT_EQ(far_road, 0);
 }

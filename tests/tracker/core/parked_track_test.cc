@@ -34,19 +34,26 @@ PointSet ParkedCorner(std::int64_t utime) {
 
 constexpr std::int64_t kStep = 100'000;  // [us] 10 Hz
 
+// Creates the parked car's track from its corner and updates it for 2 s with the same returns
+// (confirmed, not a mover). Returns the time of the last update.
+std::int64_t SeeParkedCornerFor2s(TrackManager* m, const Eigen::Vector2d& sensor) {
+  std::int64_t t = 1'000'000'000;
+  EXPECT_TRUE(m->Create(ParkedCorner(t), sensor, 1));
+  m->EndScan(t);
+  for (int k = 1; k <= 20; ++k) {
+    t += kStep;
+    m->Update(0, ParkedCorner(t), sensor, static_cast<std::uint64_t>(k), nullptr);
+    m->EndScan(t);
+  }
+  return t;
+}
+
 TEST(ParkedTrackTest, MissedParkedTrackIsLookedForWhereItWasWithoutGateGrowthAndCoastsLonger) {
   const Ekf ekf;
   const TrackManagerParams params;
   TrackManager m(params, ekf, FitParams(), ShapeParams());
   const Eigen::Vector2d sensor(0.0, 0.0);
-  std::int64_t t = 1'000'000'000;
-  ASSERT_TRUE(m.Create(ParkedCorner(t), sensor, 1));
-  m.EndScan(t);
-  for (int k = 1; k <= 20; ++k) {  // 2 s of the same returns: confirmed, not a mover
-    t += kStep;
-    m.Update(0, ParkedCorner(t), sensor, static_cast<std::uint64_t>(k), nullptr);
-    m.EndScan(t);
-  }
+  std::int64_t t = SeeParkedCornerFor2s(&m, sensor);
   ASSERT_EQ(m.tracks().size(), 1u);
   ASSERT_NE(m.tracks()[0].status, TrackStatus::kTentative);
   ASSERT_FALSE(m.tracks()[0].mover);
@@ -106,14 +113,7 @@ TEST(ParkedTrackTest, PartialViewOfAParkedCarKeepsItsTrackInPlace) {
   const TrackManagerParams params;
   TrackManager m(params, ekf, FitParams(), ShapeParams());
   const Eigen::Vector2d sensor(0.0, 0.0);
-  std::int64_t t = 1'000'000'000;
-  ASSERT_TRUE(m.Create(ParkedCorner(t), sensor, 1));
-  m.EndScan(t);
-  for (int k = 1; k <= 20; ++k) {
-    t += kStep;
-    m.Update(0, ParkedCorner(t), sensor, static_cast<std::uint64_t>(k), nullptr);
-    m.EndScan(t);
-  }
+  std::int64_t t = SeeParkedCornerFor2s(&m, sensor);
   ASSERT_EQ(m.tracks().size(), 1u);
   ASSERT_FALSE(m.tracks()[0].mover);
   for (int k = 21; k <= 50; ++k) {  // 3 s of the partial view

@@ -275,6 +275,7 @@ void Read(const YAML::Node& root, const std::string& origin, TrackerParams* p) {
     s.Get("default_dimension_std", &q.default_dimension_std);
     s.Get("small_object_extent", &q.small_object_extent);
     s.Get("small_object_position_std", &q.small_object_position_std);
+    s.Get("small_object_grown_extent", &q.small_object_grown_extent);
     s.Get("vehicle_min_length", &q.vehicle_min_length);
     s.Get("vehicle_max_length", &q.vehicle_max_length);
     s.Get("vehicle_min_width", &q.vehicle_min_width);

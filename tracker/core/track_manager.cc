@@ -200,6 +200,8 @@ bool TrackManagerParams::Validate(std::string* error) const {
              ">= 0", error) ||
       !Check(p.small_object_extent >= 0, "small_object_extent", p.small_object_extent, "m", ">= 0",
              error) ||
+      !Check(p.small_object_grown_extent >= p.small_object_extent, "small_object_grown_extent",
+             p.small_object_grown_extent, "m", ">= small_object_extent", error) ||
       !Check(p.small_object_position_std > 0, "small_object_position_std",
              p.small_object_position_std, "m", "> 0", error) ||
       !Check(p.vehicle_max_length >= p.vehicle_min_length, "vehicle_max_length",
@@ -382,7 +384,7 @@ void TrackManager::Update(std::size_t index, const PointSet& points,
   }
   t.state_utime = tm;
   const double time_s = static_cast<double>(tm) * 1e-6;
-  if (t.small_object && points.extent >= 2.0 * params_.small_object_extent) {
+  if (t.small_object && points.extent >= params_.small_object_grown_extent) {
     // A far object first seen as a few returns has grown into a rectangle: its orientation was
     // never measured (centroid updates), so it is taken afresh from this fit, keeping the
     // centre velocity; the shape starts over. Its hypotheses reduce to the first one.
@@ -392,7 +394,13 @@ void TrackManager::Update(std::size_t index, const PointSet& points,
     fresh.inside_fraction = h0.inside_fraction;
     fresh.noise_scale = h0.noise_scale;
     CentreMeasurement m;
-    if (Measure(t, &fresh, points, sensor_xy, seed, std::nullopt, false, &m) && m.z.allFinite()) {
+    // Fitted as a vehicle's rectangle (the default dimensions), not the small object's: which
+    // face a single edge is (side or end) is judged against the default width.
+    t.small_object = false;
+    const bool fitted = Measure(t, &fresh, points, sensor_xy, seed, std::nullopt, false, &m) &&
+                        m.z.allFinite();
+    t.small_object = !fitted;
+    if (fitted) {
       const Hypothesis old_ism = ekf_.Convert(t.hyps[static_cast<std::size_t>(t.selected)].filter,
                                               ModelKind::kIsm, 0.0);
       Hypothesis ism = ekf_.InitIsm(m);
@@ -409,7 +417,6 @@ void TrackManager::Update(std::size_t index, const PointSet& points,
       t.hyps.clear();
       t.hyps.push_back(std::move(fresh));
       t.selected = 0;
-      t.small_object = false;
       // Centroids of a few returns slide along a surface as the view changes: motion judged
       // from them is not evidence; the test starts over on the rectangle.
       t.mover = false;
@@ -714,10 +721,15 @@ void TrackManager::AlignToShape(Track* t) const {
   // The length axis of a vehicle is its longer side. A first fit of a partly seen object may
   // take the wrong axis (a corner whose long side is still hidden), and later fits keep the
   // heading nearest the prediction; once the estimated "width" clearly exceeds the "length",
-  // the heading turns by 90 deg and the dimensions swap.
+  // the heading turns by 90 deg and the dimensions swap. Not while the "width" is shorter than
+  // any vehicle's length: a car's end face seen whole (1.8 m) beside the first metre of its side
+  // is not a side.
   for (auto& h : t->hyps) {
     if (h.filter.kind != ModelKind::kIsm || !h.length_est || !h.width_est) continue;
-    if (*h.width_est <= params_.axis_swap_ratio * *h.length_est) continue;
+    if (*h.width_est <= std::max(params_.axis_swap_ratio * *h.length_est,
+                                 params_.vehicle_min_length)) {
+      continue;
+    }
     h.filter = ekf_.Convert(h.filter, ModelKind::kIsm, 0.5 * kPi);
     h.shape.SwapLengthAndWidth();
     h.RefreshShape();

@@ -133,6 +133,10 @@ struct TrackManagerParams {
   double default_dimension_std = 1.0;       // [m] spread of that default
   double small_object_extent = 1.0;         // [m] segments smaller than this are measured by centroid
   double small_object_position_std = 0.15;  // [m] floor of the centroid measurement std
+  // A track measured by centroids (first seen small, far away) becomes a rectangle once its
+  // segment spans this much: a car's end face seen squarely spans its width, 1.6-1.9 m (2 m
+  // before: a car coming into view end-on stayed a centroid at its face, 2.25 m from its centre).
+  double small_object_grown_extent = 1.5;   // [m] >= small_object_extent
   // Classification (track_t.object_class) from the estimated size and motion.
   double vehicle_min_length = 2.5;          // [m]
   double vehicle_max_length = 20.0;         // [m]

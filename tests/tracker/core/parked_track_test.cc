@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "tracker/core/angle.h"
 #include "tracker/core/ekf.h"
 
 namespace vtrack {
@@ -125,6 +126,87 @@ TEST(ParkedTrackTest, PartialViewOfAParkedCarKeepsItsTrackInPlace) {
   const OrientedBox box = m.Box(0);
   EXPECT_NEAR(box.center.x(), 20.0, 0.3);
   EXPECT_NEAR(box.center.y(), 5.0, 0.3);
+}
+
+// A car parked at (28, -4.6), heading 0, 4.5 x 1.8 m, seen from the origin end-on: returns on its
+// rear face (x = 25.75) over [y_lo, y_hi], and on its right side (y = -3.7) from the rear corner
+// to x = side_to (none if side_to <= 25.75), relative to the origin (28, -4.6); the outline of a
+// 3-D cloud, as vtrack-tracker fits it (the 2-D fit leaves out faces seen below 10 deg).
+PointSet RearView(std::int64_t utime, double y_lo, double y_hi, double side_to) {
+  PointSet p;
+  p.origin = Eigen::Vector2d(28.0, -4.6);
+  for (double y = y_lo; y <= y_hi + 1e-9; y += 0.1) {
+    p.x.push_back(static_cast<float>(25.75 - 28.0));
+    p.y.push_back(static_cast<float>(y + 4.6));
+  }
+  for (double x = 25.85; x <= side_to + 1e-9; x += 0.1) {
+    p.x.push_back(static_cast<float>(x - 28.0));
+    p.y.push_back(static_cast<float>(-3.7 + 4.6));
+  }
+  Eigen::Vector2d lo(25.75, y_lo), hi(std::max(25.75, side_to), y_hi);
+  if (side_to > 25.75) hi.y() = -3.7;
+  p.extent = (hi - lo).norm();
+  p.mean_utime = utime;
+  p.outline = true;  // a 3-D cloud's outline (the side, seen at 8 deg, is fitted)
+  return p;
+}
+
+// Axis error [deg] of a heading against the truth's 0, modulo 180 deg.
+double AxisErrorDeg(double theta) {
+  return std::abs(RadToDeg(std::remainder(theta, kPi)));
+}
+
+TEST(ParkedTrackTest, RearFaceSeenWholeBesideTheFirstMetreOfTheSideKeepsTheAxis) {
+  // The rear face seen whole (1.8 m) is an end: the track starts along the car. Then the first
+  // 1.2 m of its side shows too: the shape's "width" (1.8) now exceeds 1.3 x its "length" (1.2
+  // seen), and turning the axis by 90 deg (a side 1.8 m long) put the centre 1.4 m off.
+  const Ekf ekf;
+  const TrackManagerParams params;
+  TrackManager m(params, ekf, FitParams(), ShapeParams());
+  const Eigen::Vector2d sensor(0.0, 0.0);
+  std::int64_t t = 1'000'000'000;
+  ASSERT_TRUE(m.Create(RearView(t, -5.5, -3.7, 0.0), sensor, 1));
+  m.EndScan(t);
+  for (int k = 1; k <= 40; ++k) {
+    t += kStep;
+    m.Update(0, RearView(t, -5.5, -3.7, k <= 10 ? 0.0 : 26.95), sensor,
+             static_cast<std::uint64_t>(k), nullptr);
+    m.EndScan(t);
+    ASSERT_EQ(m.tracks().size(), 1u);
+    const OrientedBox box = m.Box(0);
+    EXPECT_LT(AxisErrorDeg(box.theta), 5.0) << "scan " << k;
+    EXPECT_LT((box.center - Eigen::Vector2d(28.0, -4.6)).norm(), 0.5) << "scan " << k;
+  }
+}
+
+TEST(ParkedTrackTest, FarCarFirstSeenAsAFewReturnsBecomesARectangleOnceItsRearFaceIsSeenWhole) {
+  // First 0.6 m of the rear face (a small object, measured by its centroid), then the whole
+  // face (1.8 m): the track becomes a vehicle's rectangle, the face its end, the centre half a
+  // default length behind it. (Before: it stayed a centroid at the face, 2.25 m from the centre,
+  // until the segment spanned 2 m; and the face, judged against a small object's 1 m width,
+  // was taken for a side.)
+  const Ekf ekf;
+  const TrackManagerParams params;
+  TrackManager m(params, ekf, FitParams(), ShapeParams());
+  const Eigen::Vector2d sensor(0.0, 0.0);
+  std::int64_t t = 1'000'000'000;
+  ASSERT_TRUE(m.Create(RearView(t, -4.9, -4.3, 0.0), sensor, 1));
+  m.EndScan(t);
+  ASSERT_EQ(m.tracks().size(), 1u);
+  ASSERT_TRUE(m.tracks()[0].small_object);
+  for (int k = 1; k <= 20; ++k) {
+    t += kStep;
+    const bool whole = k > 5;
+    m.Update(0, whole ? RearView(t, -5.5, -3.7, 0.0) : RearView(t, -4.9, -4.3, 0.0), sensor,
+             static_cast<std::uint64_t>(k), nullptr);
+    m.EndScan(t);
+  }
+  ASSERT_EQ(m.tracks().size(), 1u);
+  EXPECT_FALSE(m.tracks()[0].small_object);
+  const OrientedBox box = m.Box(0);
+  EXPECT_LT(AxisErrorDeg(box.theta), 5.0);
+  EXPECT_NEAR(box.center.x(), 28.0, 0.3);
+  EXPECT_NEAR(box.center.y(), -4.6, 0.3);
 }
 
 }  // namespace

@@ -61,7 +61,7 @@ EvalResult EvaluateTracks(const std::string& truth_log, const std::string& track
     }
   }
   EvalResult res;
-  std::map<std::int64_t, std::int64_t> first_seen;  // vehicle -> utime of first returns
+  std::map<std::int64_t, std::int64_t> first_seen;  // vehicle -> utime of first returns (in view anew)
   std::map<std::int64_t, std::int64_t> last_seen;   // vehicle -> utime of latest returns
   std::map<std::int64_t, double> per_n, per_pos, per_head;
   std::int64_t pairs = 0;  // every matched (vehicle, scan), due or not: for the RMSEs
@@ -69,8 +69,14 @@ EvalResult EvaluateTracks(const std::string& truth_log, const std::string& track
   std::int64_t mover_n = 0;
   for (const auto& [utime, gt] : truth) {
     for (const auto& o : gt.objects) {
-      if (o.num_points != 0 && !first_seen.count(o.id)) first_seen[o.id] = utime;
-      if (o.num_points != 0) last_seen[o.id] = utime;
+      if (o.num_points == 0) continue;
+      const auto ls = last_seen.find(o.id);
+      if (ls == last_seen.end() ||
+          (opt.reacquire_after_s > 0.0 &&
+           utime - ls->second > static_cast<std::int64_t>(opt.reacquire_after_s * 1e6))) {
+        first_seen[o.id] = utime;
+      }
+      last_seen[o.id] = utime;
     }
     const auto tl = tracks.find(utime);
     if (tl == tracks.end()) continue;

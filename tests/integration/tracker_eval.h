@@ -7,7 +7,12 @@
 // are not tentative, by centre distance (gate), minimum total distance. A vehicle counts as
 // "due" from in_view_delay_s after the first scan in which it had LADAR returns, as long as it
 // had returns within the last occlusion_grace_s (an occluded vehicle is not due); a due vehicle
-// without a match is a miss. An identity switch is a change of the track id matched to a vehicle.
+// without a match is a miss. A vehicle out of view (no returns) for longer than
+// reacquire_after_s comes into view anew when it has returns again: its first second in view
+// starts over. No tracker holds a vehicle it has not seen for that long (vtrack-tracker deletes
+// a mover's track after coast_max_s, 1.5 s); the car that passes behind a parked row in the
+// tests' lap is seen at 60 m, hidden for 2.6 s, and seen again at 32 m by 3 returns.
+// An identity switch is a change of the track id matched to a vehicle.
 #pragma once
 
 #include <cstdint>
@@ -22,6 +27,7 @@ struct EvalOptions {
   double in_view_delay_s = 1.0;  // [s] grace period after a vehicle first has returns
   double gate = 2.0;             // [m] centre distance for a match
   double occlusion_grace_s = 0.5;  // [s] a vehicle without returns for longer is not due
+  double reacquire_after_s = 1.5;  // [s] ... and one without for longer is new in view (<= 0: never)
   std::int64_t trace_vehicle = -1;  // [-] if >= 0: EvalResult::trace describes this vehicle per scan
 };
 

@@ -1,6 +1,9 @@
 // tracker-eval-scores [--max-range M] TRUTH_LOG TRACKS_LOG [TRACE_VEHICLE_ID]: prints the integration
 // tests' scores of a tracker output (tracker_eval.h); how the figures in tracker/README.md were made.
 // --max-range: vehicles within M metres of the ego are scored (default: EvalOptions, 40 m).
+// --reacquire S: a vehicle without returns for more than S seconds is new in view when seen
+// again (default: EvalOptions, 1.5 s; 0: never, a vehicle is due from its first second on).
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -10,18 +13,21 @@
 
 int main(int argc, char** argv) {
   vtrack::testing::EvalOptions opt;
-  if (argc >= 3 && std::string(argv[1]) == "--max-range") {
+  while (argc >= 3 && (std::string(argv[1]) == "--max-range" || std::string(argv[1]) == "--reacquire")) {
+    const bool range = std::string(argv[1]) == "--max-range";
     char* end = nullptr;
-    opt.max_range = std::strtod(argv[2], &end);
-    if (end == argv[2] || *end != '\0' || !(opt.max_range > 0.0)) {
-      std::fprintf(stderr, "%s: --max-range %s: not a positive number of metres\n", argv[0], argv[2]);
+    const double v = std::strtod(argv[2], &end);
+    if (end == argv[2] || *end != '\0' || !std::isfinite(v) || (range && !(v > 0.0))) {
+      std::fprintf(stderr, "%s: %s %s: not %s\n", argv[0], argv[1], argv[2],
+                   range ? "a positive number of metres" : "a number of seconds");
       return 2;
     }
+    (range ? opt.max_range : opt.reacquire_after_s) = v;
     argv += 2;
     argc -= 2;
   }
   if (argc != 3 && argc != 4) {
-    std::fprintf(stderr, "usage: %s [--max-range M] TRUTH_LOG TRACKS_LOG [TRACE_VEHICLE_ID]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s [--max-range M] [--reacquire S] TRUTH_LOG TRACKS_LOG [TRACE_VEHICLE_ID]\n", argv[0]);
     return 2;
   }
   try {

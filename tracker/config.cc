@@ -204,6 +204,7 @@ void Read(const YAML::Node& root, const std::string& origin, TrackerParams* p) {
     s.Get("partial_view_sigmas", &q.partial_view_sigmas);
     s.Get("variance_factor_sigmas", &q.variance_factor_sigmas);
     s.Get("side_face_min_excess_m", &q.side_face_min_excess_m);
+    s.Get("side_face_min_incidence_deg", &q.side_face_min_incidence_deg);
     s.Done();
   }
   {

@@ -402,7 +402,11 @@ void EdgeHeading(const Context& ctx, const FitRequest& req, const FitParams& par
         0.5 * kPi * std::round(AngleDiff(*req.predicted_theta, normal_angle) / (0.5 * kPi));
     *theta = WrapToPi(normal_angle + tau);
   } else {
-    const bool side = extent > req.width_m + params.side_face_min_excess_m;
+    // Seen at a grazing angle, a face's seen extent says nothing of its length (the side of a car
+    // parked along the road, seen from afar); a car's end ahead is seen nearly square.
+    const double cos_incidence = n_out->dot((ctx.sensor - mid).normalized());
+    const bool grazing = cos_incidence < std::cos(DegToRad(params.side_face_min_incidence_deg));
+    const bool side = extent > req.width_m + params.side_face_min_excess_m || grazing;
     *theta = InRightHalfPlane(side ? normal_angle + 0.5 * kPi : normal_angle);
   }
   *face = FaceFromNormal(normal_angle, *theta);
@@ -583,6 +587,8 @@ bool FitParams::Validate(std::string* error) const {
     e = Bad("variance_factor_sigmas", variance_factor_sigmas, "must be finite (<= 0: off)");
   } else if (!(side_face_min_excess_m >= 0.0 && std::isfinite(side_face_min_excess_m))) {
     e = Bad("side_face_min_excess_m", side_face_min_excess_m, "must be >= 0");
+  } else if (!(side_face_min_incidence_deg > 0.0 && side_face_min_incidence_deg <= 90.0)) {
+    e = Bad("side_face_min_incidence_deg", side_face_min_incidence_deg, "must be in (0, 90]");
   }
   if (!e.empty() && error) *error = e;
   return e.empty();

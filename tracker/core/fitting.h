@@ -58,7 +58,8 @@
 //    Eq. 17 is the multiple of 90 deg that brings phi nearest the prediction).
 //  - Without (new object): the axis comes from the extents - for a corner the longer edge is the
 //    length axis; a single edge is a side (length) face if its extent exceeds the width estimate
-//    by side_face_min_excess_m, else the front or rear. The sign of the heading cannot be
+//    by side_face_min_excess_m or is seen at an incidence (its normal against the ray) beyond
+//    side_face_min_incidence_deg, else the front or rear. The sign of the heading cannot be
 //    observed: theta is taken in (-pi/2, pi/2]. The tracker resolves both ambiguities over time
 //    (motion, and the two VASMs 90 deg apart, DESIGN note 9).
 // The faces then follow from the outward normals: a fitted face's outward normal points to the
@@ -114,6 +115,7 @@ struct FitParams {
   double partial_view_sigmas = 2.0;     // [-] extent shorter than the shape by more: partial view
   double variance_factor_sigmas = 3.0;  // [-] significance for scaling R by chi^2/dof; <= 0: never
   double side_face_min_excess_m = 0.4;  // [m] new object: single edge longer than width + this
+  double side_face_min_incidence_deg = 60.0;  // [deg] ... or seen at more than this: a side (90: off)
                                         //     is a side face
 
   // True if every field is valid; otherwise false and *error names the key and its value.

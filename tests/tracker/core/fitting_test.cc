@@ -960,5 +960,45 @@ TEST(Fitting, PartialFaceKeepsThePredictedPositionAlongItself) {
   EXPECT_NEAR(fit.z.x(), middle, 1e-6);
 }
 
+TEST(Fitting, NewObjectsShortFaceSeenAtAGrazingAngleIsASide) {
+  // A face 1.8 m long (a car's width; no prediction, default 4.5 x 1.8 m): seen square, it is the
+  // front or rear (the axis across it); seen at 70 deg incidence, its seen extent says nothing of
+  // its length (the side of a car parked along the road, seen from afar), so it is a side.
+  std::vector<float> x, y;
+  for (double px = 18.0; px <= 19.8 + 1e-9; px += 0.05) {
+    x.push_back(static_cast<float>(px));
+    y.push_back(10.0f);
+  }
+  const Eigen::Vector2d mid(18.9, 10.0);
+  FitRequest req;
+  req.x = x;
+  req.y = y;
+  req.length_m = 4.5;
+  req.width_m = 1.8;
+  SegmentFitter fitter;
+  FitResult fit;
+  auto axis_deg = [](double theta) { return std::abs(RadToDeg(std::remainder(theta, kPi))); };
+
+  req.sensor_xy = mid - 20.0 * Eigen::Vector2d(0.0, 1.0);  // square
+  fitter.Fit(req, &fit);
+  ASSERT_EQ(fit.kind, FitKind::kEdge) << ToString(fit.failure);
+  EXPECT_NEAR(axis_deg(fit.z.z()), 90.0, 2.0);
+  EXPECT_NEAR(fit.z.y(), 10.0 + 2.25, 0.1);  // half a length behind the face
+
+  const double inc = DegToRad(70.0);
+  req.sensor_xy = mid - 20.0 * Eigen::Vector2d(std::sin(inc), std::cos(inc));  // grazing
+  fitter.Fit(req, &fit);
+  ASSERT_EQ(fit.kind, FitKind::kEdge) << ToString(fit.failure);
+  EXPECT_LT(axis_deg(fit.z.z()), 2.0);
+  EXPECT_NEAR(fit.z.y(), 10.0 + 0.9, 0.1);  // half a width behind the face
+
+  FitParams off;
+  off.side_face_min_incidence_deg = 90.0;  // the rule off: an end again
+  SegmentFitter plain(off);
+  plain.Fit(req, &fit);
+  ASSERT_EQ(fit.kind, FitKind::kEdge) << ToString(fit.failure);
+  EXPECT_NEAR(axis_deg(fit.z.z()), 90.0, 2.0);
+}
+
 }  // namespace
 }  // namespace vtrack

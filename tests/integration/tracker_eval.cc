@@ -71,9 +71,9 @@ EvalResult EvaluateTracks(const std::string& truth_log, const std::string& track
     for (const auto& o : gt.objects) {
       if (o.num_points == 0) continue;
       const auto ls = last_seen.find(o.id);
+      const double reacquire = o.moving ? opt.reacquire_after_s : opt.reacquire_parked_after_s;
       if (ls == last_seen.end() ||
-          (opt.reacquire_after_s > 0.0 &&
-           utime - ls->second > static_cast<std::int64_t>(opt.reacquire_after_s * 1e6))) {
+          (reacquire > 0.0 && utime - ls->second > static_cast<std::int64_t>(reacquire * 1e6))) {
         first_seen[o.id] = utime;
       }
       last_seen[o.id] = utime;

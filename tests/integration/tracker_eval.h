@@ -8,10 +8,12 @@
 // "due" from in_view_delay_s after the first scan in which it had LADAR returns, as long as it
 // had returns within the last occlusion_grace_s (an occluded vehicle is not due); a due vehicle
 // without a match is a miss. A vehicle out of view (no returns) for longer than
-// reacquire_after_s comes into view anew when it has returns again: its first second in view
-// starts over. No tracker holds a vehicle it has not seen for that long (vtrack-tracker deletes
-// a mover's track after coast_max_s, 1.5 s); the car that passes behind a parked row in the
-// tests' lap is seen at 60 m, hidden for 2.6 s, and seen again at 32 m by 3 returns.
+// reacquire_after_s (a moving vehicle; reacquire_parked_after_s one that is not) comes into view
+// anew when it has returns again: its first second in view starts over. These are the tracker's
+// coast limits (vtrack-tracker deletes a mover's track after coast_max_s, 1.5 s, a parked one's
+// after parked_coast_max_s, 3 s): a vehicle hidden for longer is not expected to be held. The
+// car that passes behind a parked row in the tests' lap is seen at 60 m, hidden for 2.6 s, and
+// seen again at 32 m by 3 returns.
 // An identity switch is a change of the track id matched to a vehicle.
 #pragma once
 
@@ -28,6 +30,7 @@ struct EvalOptions {
   double gate = 2.0;             // [m] centre distance for a match
   double occlusion_grace_s = 0.5;  // [s] a vehicle without returns for longer is not due
   double reacquire_after_s = 1.5;  // [s] ... and one without for longer is new in view (<= 0: never)
+  double reacquire_parked_after_s = 3.0;  // [s] the same for a vehicle not moving (<= 0: never)
   std::int64_t trace_vehicle = -1;  // [-] if >= 0: EvalResult::trace describes this vehicle per scan
 };
 

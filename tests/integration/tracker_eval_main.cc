@@ -2,7 +2,8 @@
 // tests' scores of a tracker output (tracker_eval.h); how the figures in tracker/README.md were made.
 // --max-range: vehicles within M metres of the ego are scored (default: EvalOptions, 40 m).
 // --reacquire S: a vehicle without returns for more than S seconds is new in view when seen
-// again (default: EvalOptions, 1.5 s; 0: never, a vehicle is due from its first second on).
+// again, twice that for a vehicle not moving (default: EvalOptions, 1.5 s and 3 s; 0: never, a
+// vehicle is due from its first second on).
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -22,7 +23,12 @@ int main(int argc, char** argv) {
                    range ? "a positive number of metres" : "a number of seconds");
       return 2;
     }
-    (range ? opt.max_range : opt.reacquire_after_s) = v;
+    if (range) {
+      opt.max_range = v;
+    } else {
+      opt.reacquire_after_s = v;
+      opt.reacquire_parked_after_s = v > 0.0 ? 2.0 * v : v;
+    }
     argv += 2;
     argc -= 2;
   }

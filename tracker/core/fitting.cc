@@ -404,8 +404,11 @@ void EdgeHeading(const Context& ctx, const FitRequest& req, const FitParams& par
   } else {
     // Seen at a grazing angle, a face's seen extent says nothing of its length (the side of a car
     // parked along the road, seen from afar); a car's end ahead is seen nearly square.
-    const double cos_incidence = n_out->dot((ctx.sensor - mid).normalized());
-    const bool grazing = cos_incidence < std::cos(DegToRad(params.side_face_min_incidence_deg));
+    const Eigen::Vector2d to_sensor = ctx.sensor - mid;
+    const bool grazing = params.side_face_min_incidence_deg < 90.0 &&
+                         to_sensor.squaredNorm() > 0.0 &&
+                         n_out->dot(to_sensor.normalized()) <
+                             std::cos(DegToRad(params.side_face_min_incidence_deg));
     const bool side = extent > req.width_m + params.side_face_min_excess_m || grazing;
     *theta = InRightHalfPlane(side ? normal_angle + 0.5 * kPi : normal_angle);
   }

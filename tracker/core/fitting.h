@@ -115,8 +115,8 @@ struct FitParams {
   double partial_view_sigmas = 2.0;     // [-] extent shorter than the shape by more: partial view
   double variance_factor_sigmas = 3.0;  // [-] significance for scaling R by chi^2/dof; <= 0: never
   double side_face_min_excess_m = 0.4;  // [m] new object: single edge longer than width + this
-  double side_face_min_incidence_deg = 60.0;  // [deg] ... or seen at more than this: a side (90: off)
-                                        //     is a side face
+                                        //     is a side face ...
+  double side_face_min_incidence_deg = 60.0;  // [deg] ... or seen at more than this (90: off)
 
   // True if every field is valid; otherwise false and *error names the key and its value.
   bool Validate(std::string* error) const;

@@ -46,7 +46,8 @@
 // heading is turned by 90 deg if it runs along that face, and kept so (a parked row seen from
 // behind shows full rear faces and the first metre of each side; the longer-edge rule would
 // take the rear face for a side). Otherwise the length axis is the longer side: when the width
-// estimate exceeds axis_swap_ratio times the length estimate, the ISM heading turns by 90 deg.
+// estimate exceeds axis_swap_ratio times the length estimate and vehicle_min_length, the ISM
+// heading turns by 90 deg.
 //
 // Life cycle. tentative -> confirmed after confirm_updates updates; a tentative track missed in
 // tentative_max_misses consecutive scans is deleted. A confirmed track that gets no update is

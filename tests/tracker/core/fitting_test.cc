@@ -861,6 +861,7 @@ TEST(Fitting, ParamsValidationNamesTheKey) {
       {[](FitParams* p) { p->partial_view_sigmas = -1; }, "fitting.partial_view_sigmas = -1"},
       {[](FitParams* p) { p->variance_factor_sigmas = INFINITY; }, "fitting.variance_factor_sigmas = inf"},
       {[](FitParams* p) { p->side_face_min_excess_m = -1; }, "fitting.side_face_min_excess_m = -1"},
+      {[](FitParams* p) { p->side_face_min_incidence_deg = 0; }, "fitting.side_face_min_incidence_deg = 0"},
   };
   std::string error;
   EXPECT_TRUE(FitParams().Validate(&error));

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "tests/tracker/core/synthetic_scan.h"
@@ -992,6 +993,15 @@ TEST(Fitting, NewObjectsShortFaceSeenAtAGrazingAngleIsASide) {
   ASSERT_EQ(fit.kind, FitKind::kEdge) << ToString(fit.failure);
   EXPECT_LT(axis_deg(fit.z.z()), 2.0);
   EXPECT_NEAR(fit.z.y(), 10.0 + 0.9, 0.1);  // half a width behind the face
+
+  // Either side of the threshold (60 deg by default): an end at 55 deg, a side at 65 deg.
+  for (const auto& [deg, side] : {std::pair{55.0, false}, std::pair{65.0, true}}) {
+    const double a = DegToRad(deg);
+    req.sensor_xy = mid - 20.0 * Eigen::Vector2d(std::sin(a), std::cos(a));
+    fitter.Fit(req, &fit);
+    ASSERT_EQ(fit.kind, FitKind::kEdge) << deg << " deg: " << ToString(fit.failure);
+    EXPECT_NEAR(axis_deg(fit.z.z()), side ? 0.0 : 90.0, 2.0) << deg << " deg";
+  }
 
   FitParams off;
   off.side_face_min_incidence_deg = 90.0;  // the rule off: an end again

@@ -209,5 +209,65 @@ TEST(ParkedTrackTest, FarCarFirstSeenAsAFewReturnsBecomesARectangleOnceItsRearFa
   EXPECT_NEAR(box.center.y(), -4.6, 0.3);
 }
 
+TEST(ParkedTrackTest, GrownSmallObjectWhoseFitFailsStaysASmallObjectUntilOneFits) {
+  // A small object's segment grows to the rectangle extent (1.8 m) but holds 4 returns, fewer than
+  // a fit needs (FitParams::min_points 5): the conversion's fit fails, and the track stays a
+  // small object measured by its centroid (neither lost nor left a rectangle without a fit).
+  // Once the whole face is seen it becomes the rectangle. A single-plane scan's segments (not a
+  // 3-D outline, whose fits need only TrackManagerParams::outline_min_points).
+  const auto view = [](std::int64_t utime, double y_lo, double y_hi) {
+    PointSet p = RearView(utime, y_lo, y_hi, 0.0);
+    p.outline = false;
+    return p;
+  };
+  const Ekf ekf;
+  const TrackManagerParams params;
+  const FitParams fit_params;
+  ASSERT_EQ(fit_params.min_points, 5);
+  TrackManager m(params, ekf, fit_params, ShapeParams());
+  const Eigen::Vector2d sensor(0.0, 0.0);
+  std::int64_t t = 1'000'000'000;
+  ASSERT_TRUE(m.Create(view(t, -4.9, -4.3), sensor, 1));
+  m.EndScan(t);
+  ASSERT_TRUE(m.tracks()[0].small_object);
+  const auto sparse = [&view](std::int64_t utime) {  // 4 returns over the whole rear face
+    PointSet p = view(utime, -5.5, -3.7);
+    PointSet q = p;
+    q.x.clear();
+    q.y.clear();
+    for (std::size_t i = 0; i < p.size(); i += 6) {
+      q.x.push_back(p.x[i]);
+      q.y.push_back(p.y[i]);
+    }
+    return q;
+  };
+  ASSERT_EQ(sparse(t).size(), 4u);
+  ASSERT_GE(sparse(t).extent, params.small_object_grown_extent);
+  int k = 1;
+  for (; k <= 10; ++k) {
+    t += kStep;
+    m.Update(0, sparse(t), sensor, static_cast<std::uint64_t>(k), nullptr);
+    m.EndScan(t);
+    ASSERT_EQ(m.tracks().size(), 1u) << "scan " << k;
+    EXPECT_TRUE(m.tracks()[0].small_object) << "scan " << k;
+    EXPECT_EQ(m.tracks()[0].hyps.size(), 1u) << "scan " << k;
+  }
+  // Measured by the centroid of the returns: on the rear face, near its middle.
+  const OrientedBox small = m.Box(0);
+  EXPECT_NEAR(small.center.x(), 25.75, 0.3);
+  EXPECT_NEAR(small.center.y(), -4.6, 0.4);
+  for (; k <= 25; ++k) {
+    t += kStep;
+    m.Update(0, view(t, -5.5, -3.7), sensor, static_cast<std::uint64_t>(k), nullptr);
+    m.EndScan(t);
+  }
+  ASSERT_EQ(m.tracks().size(), 1u);
+  EXPECT_FALSE(m.tracks()[0].small_object);
+  const OrientedBox box = m.Box(0);
+  EXPECT_LT(AxisErrorDeg(box.theta), 5.0);
+  EXPECT_NEAR(box.center.x(), 28.0, 0.3);
+  EXPECT_NEAR(box.center.y(), -4.6, 0.3);
+}
+
 }  // namespace
 }  // namespace vtrack

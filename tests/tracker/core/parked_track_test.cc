@@ -156,6 +156,16 @@ double AxisErrorDeg(double theta) {
   return std::abs(RadToDeg(std::remainder(theta, kPi)));
 }
 
+// The one track is RearView's car as a rectangle: along its axis, centred within 0.3 m.
+void ExpectTheRearViewsCarAsOneRectangle(const TrackManager& m) {
+  ASSERT_EQ(m.tracks().size(), 1u);
+  EXPECT_FALSE(m.tracks()[0].small_object);
+  const OrientedBox box = m.Box(0);
+  EXPECT_LT(AxisErrorDeg(box.theta), 5.0);
+  EXPECT_NEAR(box.center.x(), 28.0, 0.3);
+  EXPECT_NEAR(box.center.y(), -4.6, 0.3);
+}
+
 TEST(ParkedTrackTest, RearFaceSeenWholeBesideTheFirstMetreOfTheSideKeepsTheAxis) {
   // The rear face seen whole (1.8 m) is an end: the track starts along the car. Then the first
   // 1.2 m of its side shows too: the shape's "width" (1.8) now exceeds 1.3 x its "length" (1.2
@@ -201,12 +211,7 @@ TEST(ParkedTrackTest, FarCarFirstSeenAsAFewReturnsBecomesARectangleOnceItsRearFa
              static_cast<std::uint64_t>(k), nullptr);
     m.EndScan(t);
   }
-  ASSERT_EQ(m.tracks().size(), 1u);
-  EXPECT_FALSE(m.tracks()[0].small_object);
-  const OrientedBox box = m.Box(0);
-  EXPECT_LT(AxisErrorDeg(box.theta), 5.0);
-  EXPECT_NEAR(box.center.x(), 28.0, 0.3);
-  EXPECT_NEAR(box.center.y(), -4.6, 0.3);
+  ExpectTheRearViewsCarAsOneRectangle(m);
 }
 
 TEST(ParkedTrackTest, GrownSmallObjectWhoseFitFailsStaysASmallObjectUntilOneFits) {
@@ -261,12 +266,7 @@ TEST(ParkedTrackTest, GrownSmallObjectWhoseFitFailsStaysASmallObjectUntilOneFits
     m.Update(0, view(t, -5.5, -3.7), sensor, static_cast<std::uint64_t>(k), nullptr);
     m.EndScan(t);
   }
-  ASSERT_EQ(m.tracks().size(), 1u);
-  EXPECT_FALSE(m.tracks()[0].small_object);
-  const OrientedBox box = m.Box(0);
-  EXPECT_LT(AxisErrorDeg(box.theta), 5.0);
-  EXPECT_NEAR(box.center.x(), 28.0, 0.3);
-  EXPECT_NEAR(box.center.y(), -4.6, 0.3);
+  ExpectTheRearViewsCarAsOneRectangle(m);
 }
 
 }  // namespace

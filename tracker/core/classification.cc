@@ -1,0 +1,51 @@
+#include "tracker/core/classification.h"
+
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <cmath>
+
+namespace vtrack {
+
+MoverTest::MoverTest(double confidence, double min_speed)
+    : d2_quantile_(ChiSquareQuantile(confidence, 2)),
+      d1_quantile_(ChiSquareQuantile(confidence, 1)),
+      min_speed_(min_speed) {}
+
+std::optional<bool> MoverTest::Evidence(const Ekf& ekf, const Track& t) const {
+  const TrackHypothesis& sel = t.hyps[static_cast<std::size_t>(t.selected)];
+  if (!sel.has_fit) return std::nullopt;
+  const CentreEstimate c = ekf.Centre(sel.filter);
+  const Eigen::Matrix2d C = 0.5 * (c.velocity_cov + c.velocity_cov.transpose());
+  if (sel.fit.kind == FitKind::kEdge && c.velocity.allFinite()) {
+    const Eigen::Vector2d n(-std::sin(sel.fit.phi), std::cos(sel.fit.phi));
+    const double vn = n.dot(c.velocity), var = n.dot(C * n);
+    return var > 0.0 && vn * vn / var > d1_quantile_ && std::abs(vn) >= min_speed_;
+  }
+  Eigen::LLT<Eigen::Matrix2d> llt(C);
+  if (llt.info() == Eigen::Success && c.velocity.allFinite()) {
+    const double d2 = c.velocity.dot(llt.solve(c.velocity));
+    return d2 > d2_quantile_ && c.speed >= min_speed_;
+  }
+  return false;
+}
+
+ObjectClass Classify(const TrackManagerParams& params, const Track& t) {
+  if (t.small_object) return ObjectClass::kOther;
+  const TrackHypothesis& sel = t.hyps[static_cast<std::size_t>(t.selected)];
+  const double est_l = sel.length_est.value_or(0.0), est_w = sel.width_est.value_or(0.0);
+  const bool vehicle_size = est_l <= params.vehicle_max_length &&
+                            est_w <= params.vehicle_max_width &&
+                            std::max(est_l, est_w) >= params.vehicle_min_length &&
+                            std::min(est_l, est_w) >= params.vehicle_min_width * 0.5;
+  // A stationary object seen in part (a parked car from one corner).
+  const bool full_face_vehicle = t.axis_from_full_face &&
+                                 t.full_face_extent >= params.vehicle_min_width &&
+                                 t.full_face_extent <= params.vehicle_max_width &&
+                                 est_l <= params.vehicle_max_length &&
+                                 std::min(est_l, est_w) >= 0.5 * params.vehicle_min_width;
+  const bool mover = t.mover && std::max(est_l, est_w) >= params.vehicle_min_width;
+  return vehicle_size || full_face_vehicle || mover ? ObjectClass::kVehicle : ObjectClass::kOther;
+}
+
+}  // namespace vtrack

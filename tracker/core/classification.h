@@ -1,0 +1,36 @@
+// What a track is: a mover or not (the mover test on its velocity), and its object class
+// (vehicle or other) from its estimated size and motion (track_manager.h describes both).
+#pragma once
+
+#include <optional>
+
+#include "tracker/core/ekf.h"
+#include "tracker/core/track.h"
+#include "tracker/core/track_manager_params.h"
+
+namespace vtrack {
+
+// The mover test of one scan. The centre velocity v and its covariance C of the reported
+// hypothesis give d^2 = v^T C^-1 v; the scan is evidence of motion if d^2 exceeds the
+// chi-square (2 dof) quantile of `confidence` and |v| >= min_speed. After a single-edge fit only
+// the velocity across the edge counts (1 dof): along it the centre follows the extent of the
+// returns, which slides as the ego passes a parked car.
+class MoverTest {
+ public:
+  MoverTest(double confidence, double min_speed);
+  // Evidence of motion on this scan; nullopt without a fit (a centroid slides with the view
+  // just the same, so it is no evidence either way).
+  std::optional<bool> Evidence(const Ekf& ekf, const Track& t) const;
+
+ private:
+  double d2_quantile_ = 0.0;  // chi-square quantile, 2 dof
+  double d1_quantile_ = 0.0;  // chi-square quantile, 1 dof
+  double min_speed_ = 0.0;    // [m/s]
+};
+
+// The class of t: a vehicle if its estimated size (not the default lower bound) fits a vehicle,
+// or a face of a car's front or rear width was seen whole and the rest fits, or it is a mover of
+// any plausible size; otherwise other. Small objects are other.
+ObjectClass Classify(const TrackManagerParams& params, const Track& t);
+
+}  // namespace vtrack

@@ -1,0 +1,35 @@
+// A track's life cycle (track_manager.h, "Life cycle"): tentative -> confirmed after
+// confirm_updates updates, deleted after tentative_max_misses misses while tentative; a
+// confirmed track without an update is coasting, deleted after coast_max_s (parked_coast_max_s
+// for a parked object) or once its position is less certain than max_position_std; of two
+// overlapping tracks one goes.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "tracker/core/association.h"
+#include "tracker/core/ekf.h"
+#include "tracker/core/track.h"
+#include "tracker/core/track_manager_params.h"
+
+namespace vtrack {
+
+// Confirmed or coasting, not a mover, and slower than mover_min_speed.
+bool Parked(const Ekf& ekf, double mover_min_speed, const Track& t);
+
+// Advances t's status after a scan at utime; predicted: its reported hypothesis at utime. False
+// if the track is to be deleted.
+bool AdvanceStatus(const Ekf& ekf, const TrackManagerParams& params, std::int64_t utime,
+                   const Hypothesis& predicted, Track* t);
+
+// Marks in *remove one of every two tracks whose rectangles (boxes, same order as tracks)
+// overlap by more than duplicate_overlap of the smaller one: a small object inside a vehicle's
+// rectangle, else the one with fewer updates, else the younger.
+void MarkDuplicates(const TrackManagerParams& params, const std::vector<Track>& tracks,
+                    const std::vector<PredictedObject>& boxes, std::vector<char>* remove);
+
+// Fraction of a 5 x 3 lattice over the smaller rectangle that lies inside the other.
+double Overlap(const OrientedBox& a, const OrientedBox& b);
+
+}  // namespace vtrack

@@ -1,0 +1,89 @@
+#include "tracker/core/range_profile.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "tracker/core/angle.h"
+#include "tracker/core/fast_atan2.h"
+
+namespace vtrack {
+
+void RangeProfile::Build(const Eigen::Vector2d& sensor_xy, const std::vector<double>& x,
+                         const std::vector<double>& y, double bin_deg) {
+  Build(sensor_xy, x, y, {}, bin_deg);
+}
+
+void RangeProfile::Build(const Eigen::Vector2d& sensor_xy, const std::vector<double>& x,
+                         const std::vector<double>& y, const std::vector<std::int16_t>& ring,
+                         double bin_deg) {
+  sensor_ = sensor_xy;
+  num_bins_ = std::max(1, static_cast<int>(std::ceil(360.0 / bin_deg)));
+  inv_bin_ = num_bins_ / (2.0 * kPi);
+  const bool rings = ring.size() == x.size();
+  auto ring_of = [&](std::size_t i) {
+    return rings ? std::clamp<int>(ring[i], 0, kMaxRings - 1) : 0;
+  };
+  num_rings_ = 1;
+  for (std::size_t i = 0; rings && i < x.size(); ++i) num_rings_ = std::max(num_rings_, ring_of(i) + 1);
+  nearest_.assign(static_cast<std::size_t>(num_rings_) * static_cast<std::size_t>(num_bins_),
+                  std::numeric_limits<float>::infinity());
+  // The bin Bin() gives, with Atan2Approx wherever its error bound (with ample slack for the
+  // rounding of the sum and product) cannot change the floor; else Bin() itself. Same bins.
+  const int n = num_bins_;
+  const double slack = 10.0 * kAtan2ApproxMaxError * inv_bin_ + 1e-9;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const Eigen::Vector2d p(x[i], y[i]);
+    const Eigen::Vector2d d = p - sensor_;
+    const double v = (Atan2Approx(d.y(), d.x()) + kPi) * inv_bin_;
+    const double lo = std::floor(v - slack);
+    int b;
+    if (lo == std::floor(v + slack)) {
+      b = static_cast<int>(lo);  // in [-1, n]: the wrap of Bin() without its two divisions
+      if (b < 0) b += n;
+      else if (b >= n) b -= n;
+    } else {
+      b = Bin(p);
+    }
+    float& r = nearest_[static_cast<std::size_t>(ring_of(i)) * static_cast<std::size_t>(n) +
+                        static_cast<std::size_t>(b)];
+    r = std::min(r, static_cast<float>(d.norm()));
+  }
+}
+
+int RangeProfile::Bin(const Eigen::Vector2d& p) const {
+  const Eigen::Vector2d d = p - sensor_;
+  const int n = num_bins_;
+  const int b = static_cast<int>(std::floor((std::atan2(d.y(), d.x()) + kPi) * inv_bin_));
+  return ((b % n) + n) % n;
+}
+
+bool RangeProfile::FreeBeyond(const Eigen::Vector2d& end, const Eigen::Vector2d& inner,
+                              double margin, int bins) const {
+  if (nearest_.empty()) return false;
+  const Eigen::Vector2d de = end - sensor_, di = inner - sensor_;
+  // Beyond = the rotation sense from inner to end.
+  const int step = de.x() * di.y() - de.y() * di.x() < 0.0 ? 1 : -1;
+  const int n = num_bins_;
+  const double r = de.norm();
+  const int b0 = Bin(end);
+  const int b_in = (((b0 - step) % n) + n) % n;
+  // The rings that see the face at its end; every ring if none does.
+  bool any_on_face = false;
+  for (int ring = 0; ring < num_rings_ && !any_on_face; ++ring) {
+    any_on_face = std::abs(Nearest(ring, b0) - r) <= margin || std::abs(Nearest(ring, b_in) - r) <= margin;
+  }
+  for (int ring = 0; ring < num_rings_; ++ring) {
+    if (any_on_face && std::abs(Nearest(ring, b0) - r) > margin &&
+        std::abs(Nearest(ring, b_in) - r) > margin) {
+      continue;
+    }
+    for (int k = 1; k <= bins; ++k) {
+      const int b = (((b0 + step * k) % n) + n) % n;
+      if (Nearest(ring, b) < r + margin) return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace vtrack

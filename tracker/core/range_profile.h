@@ -1,0 +1,49 @@
+// The scan's range profile: the nearest return per bearing around the sensor, per ring. The
+// orientation rules ask it whether a fitted face was seen whole (track_manager.h).
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <vector>
+
+namespace vtrack {
+
+// The nearest return per bearing bin around the sensor, over every return of a scan, per ring of
+// a 3-D scanner. It tells whether a fitted face ends where the object ends (free space, or only
+// farther returns, just beyond the end: a full view of that face) or where something nearer
+// hides the rest of it. Per ring: a 3-D scanner sees over low objects near it (a car's bonnet
+// 4 m away hides a face 40 m away from the downward rings only, not from the rings that hit the
+// face); a profile over all rings read those as occluders beyond every end of the far face.
+class RangeProfile {
+ public:
+  // bin_deg: bearing bin [deg], > 0. One profile over all returns (a single-plane scanner).
+  void Build(const Eigen::Vector2d& sensor_xy, const std::vector<double>& x,
+             const std::vector<double>& y, double bin_deg);
+  // One profile per ring (ring[i] of return i; rings outside [0, kMaxRings) share the last).
+  void Build(const Eigen::Vector2d& sensor_xy, const std::vector<double>& x,
+             const std::vector<double>& y, const std::vector<std::int16_t>& ring, double bin_deg);
+  // True if, in the `bins` bearing bins just beyond `end` (on the side away from `inner`, the
+  // face's other end), no return lies nearer than end's range + margin, on the rings that see
+  // the face at its end (a return within margin of end's range in end's bin or the one inside
+  // it); on every ring if none does.
+  bool FreeBeyond(const Eigen::Vector2d& end, const Eigen::Vector2d& inner, double margin,
+                  int bins) const;
+  bool empty() const { return nearest_.empty(); }
+
+  static constexpr int kMaxRings = 256;
+
+ private:
+  int Bin(const Eigen::Vector2d& p) const;
+  float Nearest(int ring, int bin) const {
+    return nearest_[static_cast<std::size_t>(ring) * static_cast<std::size_t>(num_bins_) +
+                    static_cast<std::size_t>(bin)];
+  }
+  Eigen::Vector2d sensor_ = Eigen::Vector2d::Zero();
+  double inv_bin_ = 0.0;  // [1/rad]
+  int num_bins_ = 0;
+  int num_rings_ = 0;
+  std::vector<float> nearest_;  // [m] per (ring, bin), ring-major; +inf where no return
+};
+
+}  // namespace vtrack

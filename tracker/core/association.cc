@@ -12,6 +12,8 @@ namespace vtrack {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Slack on the bounds of a created rectangle, for the rounding of its corners.
+constexpr double kBoundsSlack = 1e-3;  // [m]
 
 std::string Bad(const char* key, double value, const char* constraint) {
   std::ostringstream os;
@@ -118,121 +120,6 @@ std::string AssociationParams::FirstProblem() const {
   if (!(join_max_extent >= join_max_piece && join_max_extent <= 50.0))
     return Bad("join_max_extent", join_max_extent, "must be in [join_max_piece, 50] m");
   return {};
-}
-
-int JoinGrazingPieces(const WorldPoints& pts, const Eigen::Vector2d& sensor_xy,
-                      const AssociationParams& params, Segments* segments) {
-  auto& segs = segments->segments;
-  if (params.join_max_piece <= 0.0 || segs.size() < 2) return 0;
-  struct Piece {
-    double bearing;   // [rad] of the centroid seen from the sensor
-    double range;     // [m]
-    std::int32_t seg;
-  };
-  std::vector<Piece> pieces;
-  for (std::size_t k = 0; k < segs.size(); ++k) {
-    const Segment& g = segs[k];
-    if ((g.max - g.min).norm() >= params.join_max_piece) continue;
-    const Eigen::Vector2d d = g.centroid - sensor_xy;
-    pieces.push_back({std::atan2(d.y(), d.x()), d.norm(), static_cast<std::int32_t>(k)});
-  }
-  const std::size_t n = pieces.size();
-  if (n < 2) return 0;
-  std::sort(pieces.begin(), pieces.end(), [](const Piece& a, const Piece& b) {
-    return a.bearing < b.bearing || (a.bearing == b.bearing && a.seg < b.seg);
-  });
-  // Candidate pairs. For B to lie within join_max_deg of A's ray at a distance <= gap, its
-  // bearing differs by at most asin(gap * sin(deg) / range(B)), range(B) >= range(A) - gap:
-  // pieces sorted by bearing are scanned within that window (both ways round the circle).
-  const double sin_max = std::sin(DegToRad(params.join_max_deg));
-  const double gap = params.join_max_gap;
-  struct Pair {
-    double dist;
-    std::int32_t a, b;  // indices into segs
-  };
-  std::vector<Pair> pairs;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double r_min = std::max(0.5, pieces[i].range - gap);
-    const double window = std::asin(std::min(1.0, gap * sin_max / r_min)) + 1e-9;
-    for (std::size_t step = 1; step < n; ++step) {
-      const Piece& q = pieces[(i + step) % n];
-      double db = q.bearing - pieces[i].bearing;
-      if (db < 0.0) db += 2.0 * kPi;
-      if (db > window) break;
-      const Eigen::Vector2d ca = segs[static_cast<std::size_t>(pieces[i].seg)].centroid;
-      const Eigen::Vector2d cb = segs[static_cast<std::size_t>(q.seg)].centroid;
-      const Eigen::Vector2d ab = cb - ca;
-      const double dist = ab.norm();
-      if (dist > gap || dist <= 0.0) continue;
-      const Eigen::Vector2d ray = (0.5 * (ca + cb) - sensor_xy).normalized();
-      if (std::abs(ray.x() * ab.y() - ray.y() * ab.x()) > sin_max * dist) continue;
-      pairs.push_back({dist, pieces[i].seg, q.seg});
-    }
-  }
-  if (pairs.empty()) return 0;
-  std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
-    return a.dist < b.dist || (a.dist == b.dist && (a.a < b.a || (a.a == b.a && a.b < b.b)));
-  });
-  // Union-find over segments with the bounding box of each set at its root.
-  std::vector<std::int32_t> parent(segs.size());
-  for (std::size_t k = 0; k < segs.size(); ++k) parent[k] = static_cast<std::int32_t>(k);
-  std::vector<Eigen::Vector2d> lo(segs.size()), hi(segs.size());
-  for (std::size_t k = 0; k < segs.size(); ++k) {
-    lo[k] = segs[k].min;
-    hi[k] = segs[k].max;
-  }
-  auto find = [&](std::int32_t k) {
-    while (parent[static_cast<std::size_t>(k)] != k) {
-      parent[static_cast<std::size_t>(k)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(k)])];
-      k = parent[static_cast<std::size_t>(k)];
-    }
-    return k;
-  };
-  int joins = 0;
-  for (const Pair& pr : pairs) {
-    std::int32_t a = find(pr.a), b = find(pr.b);
-    if (a == b) continue;
-    const Eigen::Vector2d l = lo[static_cast<std::size_t>(a)].cwiseMin(lo[static_cast<std::size_t>(b)]);
-    const Eigen::Vector2d h = hi[static_cast<std::size_t>(a)].cwiseMax(hi[static_cast<std::size_t>(b)]);
-    if ((h - l).norm() > params.join_max_extent) continue;
-    if (b < a) std::swap(a, b);
-    parent[static_cast<std::size_t>(b)] = a;  // the lowest segment index is the root
-    lo[static_cast<std::size_t>(a)] = l;
-    hi[static_cast<std::size_t>(a)] = h;
-    ++joins;
-  }
-  if (joins == 0) return 0;
-  // Rebuild: each root segment followed by the returns of the segments joined to it.
-  std::vector<std::vector<std::int32_t>> members(segs.size());
-  for (std::size_t k = 0; k < segs.size(); ++k) {
-    members[static_cast<std::size_t>(find(static_cast<std::int32_t>(k)))].push_back(static_cast<std::int32_t>(k));
-  }
-  std::vector<std::int32_t> point;
-  point.reserve(segments->point.size());
-  std::vector<Segment> out;
-  out.reserve(segs.size());
-  for (std::size_t k = 0; k < segs.size(); ++k) {
-    if (members[k].empty()) continue;  // joined to another root
-    Segment g;
-    g.begin = static_cast<std::int32_t>(point.size());
-    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-    for (const std::int32_t m : members[k]) {
-      const Segment& src = segs[static_cast<std::size_t>(m)];
-      for (std::int32_t i = src.begin; i < src.end; ++i) {
-        const std::int32_t p = segments->point[static_cast<std::size_t>(i)];
-        point.push_back(p);
-        sum += Eigen::Vector2d(pts.x[static_cast<std::size_t>(p)], pts.y[static_cast<std::size_t>(p)]);
-      }
-    }
-    g.end = static_cast<std::int32_t>(point.size());
-    g.min = lo[k];
-    g.max = hi[k];
-    g.centroid = sum / static_cast<double>(g.size());
-    out.push_back(g);
-  }
-  segments->point.swap(point);
-  segs.swap(out);
-  return joins;
 }
 
 std::vector<int> SolveAssignment(const std::vector<double>& cost, int rows, int cols) {
@@ -380,111 +267,140 @@ double Associator::PairCost(const PredictedObject& t, double margin, std::uint8_
   return dist_sum / static_cast<double>(inside) + params_.outside_penalty * (1.0 - frac);
 }
 
-void Associator::BuildParts(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
-                            const Segments& segments) {
-  num_parts_ = 0;
-  // Part buffers are kept from scan to scan, but not beyond twice what this scan's segments
-  // hold: otherwise every slot would keep the largest part it ever held (RSS creeping up over a
-  // long run although nothing leaks).
-  std::size_t retained = 0;
-  for (const Part& part : parts_) retained += part.points.capacity();
-  if (retained > 2 * segments.point.size() + 4096) parts_.clear();
-  const std::size_t nt = tracks.size();
+namespace {
+
+// A return's coordinates in a rectangle's frame (as BoxFrame::To).
+inline Eigen::Vector2d InFrame(const Associator::RectFrame& f, double x, double y) {
+  const double dx = x - f.cx, dy = y - f.cy;
+  return {dx * f.ax + dy * f.ay, -dx * f.ay + dy * f.ax};
+}
+
+// Part buffers are kept from scan to scan, but not beyond twice what this scan's segments hold
+// (plus this many returns): otherwise every slot would keep the largest part it ever held (RSS
+// creeping up over a long run although nothing leaks).
+constexpr std::size_t kRetainedSlack = 4096;
+
+}  // namespace
+
+void Associator::IndexClaimingGates(const std::vector<PredictedObject>& tracks) {
   // Per track once per scan: gate bounds, frame (cos/sin) and grown half sizes. Only established
   // tracks claim, so only their gates are indexed.
+  const std::size_t nt = tracks.size();
   std::vector<Eigen::Vector2d> lo(nt), hi(nt);
   std::vector<char> established(nt, 0);
-  std::vector<BoxFrame> frames;
-  frames.reserve(nt);
-  std::vector<double> gate_hl(nt), gate_hw(nt);
+  gates_.clear();
   for (std::size_t j = 0; j < nt; ++j) {
     const double margin = GateMargin(tracks[j]);
     GateBounds(tracks[j].box, margin, &lo[j], &hi[j]);
     established[j] = tracks[j].established ? 1 : 0;
-    frames.emplace_back(tracks[j].box);
-    gate_hl[j] = 0.5 * tracks[j].box.length + margin;
-    gate_hw[j] = 0.5 * tracks[j].box.width + margin;
+    const BoxFrame frame(tracks[j].box);
+    gates_.push_back({frame.c.x(), frame.c.y(), frame.ax, frame.ay,
+                      0.5 * tracks[j].box.length + margin, 0.5 * tracks[j].box.width + margin});
   }
   sorted_.Build(lo, hi, established);
+}
+
+void Associator::ClaimingTracks(const Segment& s, const WorldPoints& pts,
+                                const Segments& segments, std::vector<std::size_t>* claim) {
+  // Established tracks with at least split_min_points of this segment's returns inside their
+  // gate, in track order.
+  claim->clear();
+  sorted_.Overlapping(s.min, s.max, &candidates_);
+  for (const std::int32_t jj : candidates_) {
+    const auto j = static_cast<std::size_t>(jj);
+    const RectFrame& g = gates_[j];
+    int inside = 0;  // counted up to split_min_points: all the claim needs
+    for (std::int32_t k = s.begin; k < s.end && inside < params_.split_min_points; ++k) {
+      const auto i = static_cast<std::size_t>(segments.point[static_cast<std::size_t>(k)]);
+      const Eigen::Vector2d q = InFrame(g, pts.x[i], pts.y[i]);
+      if (std::abs(q.x()) <= g.hl && std::abs(q.y()) <= g.hw) ++inside;
+    }
+    if (inside >= params_.split_min_points) claim->push_back(j);
+  }
+}
+
+void Associator::SplitAmong(const std::vector<PredictedObject>& tracks,
+                            const std::vector<std::size_t>& claim, const WorldPoints& pts,
+                            const std::int32_t* begin, const std::int32_t* end, std::size_t first) {
+  // Each return goes to the claimant it is nearest to, ordered by the signed distance to the
+  // rectangle boundary (> 0 outside, <= 0 inside): the distance inside, its square outside.
+  // Most segments of a KITTI scan are claimed by two or more tracks (clutter tracks on
+  // vegetation and walls overlap): the claimants' frames side by side.
+  claimants_.clear();
+  for (const std::size_t j : claim) {
+    const RectFrame& g = gates_[j];
+    claimants_.push_back({g.cx, g.cy, g.ax, g.ay, 0.5 * tracks[j].box.length,
+                          0.5 * tracks[j].box.width});
+  }
+  const RectFrame* const cl = claimants_.data();
+  const std::size_t nc = claimants_.size();
+  for (const std::int32_t* it = begin; it != end; ++it) {
+    const std::int32_t i = *it;
+    const auto iu = static_cast<std::size_t>(i);
+    const double px = pts.x[iu], py = pts.y[iu];
+    std::size_t best = 0;
+    double best_d = kInf;
+    for (std::size_t c = 0; c < nc; ++c) {
+      const Eigen::Vector2d q = InFrame(cl[c], px, py);
+      const double ex = std::abs(q.x()) - cl[c].hl, ey = std::abs(q.y()) - cl[c].hw;
+      const double ox = std::max(ex, 0.0), oy = std::max(ey, 0.0);
+      const double d = ex > 0.0 || ey > 0.0 ? ox * ox + oy * oy : std::max(ex, ey);
+      if (d < best_d) {
+        best_d = d;
+        best = c;
+      }
+    }
+    parts_[first + best].points.push_back(i);
+  }
+}
+
+std::size_t Associator::BoundParts(const WorldPoints& pts, std::size_t first, bool split) {
+  // Bounding boxes; drops pieces of a split that are too small to fit (their buffers are kept
+  // for reuse: swapped, not moved, to the end). Returns the new end of the parts in use.
+  std::size_t w = first;
+  for (std::size_t q = first; q < num_parts_; ++q) {
+    Part& part = parts_[q];
+    if (split && static_cast<int>(part.points.size()) < params_.split_min_points) continue;
+    part.min = Eigen::Vector2d::Constant(kInf);
+    part.max = -part.min;
+    for (const std::int32_t i : part.points) {
+      const Eigen::Vector2d p(pts.x[static_cast<std::size_t>(i)], pts.y[static_cast<std::size_t>(i)]);
+      part.min = part.min.cwiseMin(p);
+      part.max = part.max.cwiseMax(p);
+    }
+    if (w != q) {
+      std::swap(parts_[w].points, part.points);
+      parts_[w].min = part.min;
+      parts_[w].max = part.max;
+    }
+    ++w;
+  }
+  return w;
+}
+
+void Associator::BuildParts(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
+                            const Segments& segments) {
+  num_parts_ = 0;
+  std::size_t retained = 0;
+  for (const Part& part : parts_) retained += part.points.capacity();
+  if (retained > 2 * segments.point.size() + kRetainedSlack) parts_.clear();
+  IndexClaimingGates(tracks);
   std::vector<std::size_t> claim;
   for (const Segment& s : segments.segments) {
-    // Established tracks with enough of this segment's returns inside their gate, in track order.
-    claim.clear();
-    sorted_.Overlapping(s.min, s.max, &candidates_);
-    for (const std::int32_t jj : candidates_) {
-      const auto j = static_cast<std::size_t>(jj);
-      const double hl = gate_hl[j], hw = gate_hw[j];
-      const BoxFrame& frame = frames[j];
-      int inside = 0;  // counted up to split_min_points: all the claim needs
-      for (std::int32_t k = s.begin; k < s.end && inside < params_.split_min_points; ++k) {
-        const auto i = static_cast<std::size_t>(segments.point[static_cast<std::size_t>(k)]);
-        const Eigen::Vector2d q = frame.To(pts.x[i], pts.y[i]);
-        if (std::abs(q.x()) <= hl && std::abs(q.y()) <= hw) ++inside;
-      }
-      if (inside >= params_.split_min_points) claim.push_back(j);
-    }
+    ClaimingTracks(s, pts, segments, &claim);
     const std::size_t first = num_parts_;
     const std::size_t num_parts = claim.size() >= 2 ? claim.size() : 1;
     if (parts_.size() < first + num_parts) parts_.resize(first + num_parts);
     for (std::size_t q = first; q < first + num_parts; ++q) parts_[q].points.clear();
     num_parts_ = first + num_parts;
-    const auto seg_begin = segments.point.begin() + s.begin;
-    const auto seg_end = segments.point.begin() + s.end;
+    const std::int32_t* seg_begin = segments.point.data() + s.begin;
+    const std::int32_t* seg_end = segments.point.data() + s.end;
     if (num_parts == 1) {
       parts_[first].points.assign(seg_begin, seg_end);
     } else {
-      // Each return goes to the claimant it is nearest to, ordered by the signed distance to
-      // the rectangle boundary (> 0 outside, <= 0 inside): the distance inside, its square
-      // outside. Most segments of a KITTI scan are claimed by two or more tracks (clutter
-      // tracks on vegetation and walls overlap): the claimants' frames side by side.
-      claimants_.clear();
-      for (const std::size_t j : claim) {
-        claimants_.push_back({frames[j].c.x(), frames[j].c.y(), frames[j].ax, frames[j].ay,
-                              0.5 * tracks[j].box.length, 0.5 * tracks[j].box.width});
-      }
-      const Claimant* const cl = claimants_.data();
-      const std::size_t nc = claimants_.size();
-      for (auto it = seg_begin; it != seg_end; ++it) {
-        const std::int32_t i = *it;
-        const auto iu = static_cast<std::size_t>(i);
-        const double px = pts.x[iu], py = pts.y[iu];
-        std::size_t best = 0;
-        double best_d = kInf;
-        for (std::size_t c = 0; c < nc; ++c) {
-          const double dx = px - cl[c].cx, dy = py - cl[c].cy;
-          const double qx = dx * cl[c].ax + dy * cl[c].ay, qy = -dx * cl[c].ay + dy * cl[c].ax;
-          const double ex = std::abs(qx) - cl[c].hl, ey = std::abs(qy) - cl[c].hw;
-          const double ox = std::max(ex, 0.0), oy = std::max(ey, 0.0);
-          const double d = ex > 0.0 || ey > 0.0 ? ox * ox + oy * oy : std::max(ex, ey);
-          if (d < best_d) {
-            best_d = d;
-            best = c;
-          }
-        }
-        parts_[first + best].points.push_back(i);
-      }
+      SplitAmong(tracks, claim, pts, seg_begin, seg_end, first);
     }
-    // Bounding boxes; drop pieces of a split that are too small to fit (their buffers are kept
-    // for reuse: swapped, not moved, to the end).
-    std::size_t w = first;
-    for (std::size_t q = first; q < num_parts_; ++q) {
-      Part& part = parts_[q];
-      if (num_parts > 1 && static_cast<int>(part.points.size()) < params_.split_min_points) continue;
-      part.min = Eigen::Vector2d::Constant(kInf);
-      part.max = -part.min;
-      for (const std::int32_t i : part.points) {
-        const Eigen::Vector2d p(pts.x[static_cast<std::size_t>(i)], pts.y[static_cast<std::size_t>(i)]);
-        part.min = part.min.cwiseMin(p);
-        part.max = part.max.cwiseMax(p);
-      }
-      if (w != q) {
-        std::swap(parts_[w].points, part.points);
-        parts_[w].min = part.min;
-        parts_[w].max = part.max;
-      }
-      ++w;
-    }
-    num_parts_ = w;
+    num_parts_ = BoundParts(pts, first, num_parts > 1);
   }
 }
 
@@ -549,6 +465,241 @@ bool Associator::JoinMover(const std::vector<PredictedObject>& tracks, const Wor
   return false;
 }
 
+void Associator::CandidatePairs(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
+                                const Eigen::Vector2d& sensor_xy, std::vector<Pair>* pairs) {
+  // Candidate pairs and their costs, in (track, part) order; each track's gate is tested only
+  // against the parts whose x range may overlap it.
+  pairs->clear();
+  const std::size_t np = num_parts_;
+  {
+    std::vector<Eigen::Vector2d> part_lo(np), part_hi(np);
+    for (std::size_t q = 0; q < np; ++q) {
+      part_lo[q] = parts_[q].min;
+      part_hi[q] = parts_[q].max;
+    }
+    sorted_.Build(part_lo, part_hi, {});
+  }
+  const double slant = DegToRad(params_.min_slant_deg);
+  Eigen::Vector2d lo, hi;
+  for (std::size_t j = 0; j < tracks.size(); ++j) {
+    const double margin = GateMargin(tracks[j]);
+    GateBounds(tracks[j].box, margin, &lo, &hi);
+    sorted_.Overlapping(lo, hi, &candidates_);
+    std::uint8_t visible = 0;
+    bool have_visible = false;
+    for (const std::int32_t qq : candidates_) {
+      const auto q = static_cast<std::size_t>(qq);
+      if (!have_visible) {
+        visible = VisibleFaces(tracks[j].box, sensor_xy, slant);
+        if (visible == 0) visible = 0xF;  // sensor inside or on the rectangle: any face
+        have_visible = true;
+      }
+      double inside = 0.0;
+      const double c = PairCost(tracks[j], margin, visible, parts_[q], pts, &inside);
+      if (std::isfinite(c)) pairs->push_back({static_cast<int>(j), static_cast<int>(q), c, inside});
+    }
+  }
+}
+
+namespace {
+
+// Not a candidate: far more than leaving the track unassigned, so never chosen.
+constexpr double kForbidden = 1e6;
+
+double FractionOnRectangle(const OrientedBox& box, double margin, const WorldPoints& pts,
+                           const std::vector<std::int32_t>& idx, Eigen::Vector2d* lo = nullptr,
+                           Eigen::Vector2d* hi = nullptr) {
+  // The returns' fraction within the rectangle grown by margin, and their bounding box in the
+  // rectangle's frame (lo, hi optional).
+  const BoxFrame frame(box);
+  const double hl = 0.5 * box.length + margin;
+  const double hw = 0.5 * box.width + margin;
+  Eigen::Vector2d lo_all = Eigen::Vector2d::Constant(kInf), hi_all = -lo_all;
+  int on_box = 0;
+  for (const std::int32_t i : idx) {
+    const auto iu = static_cast<std::size_t>(i);
+    const Eigen::Vector2d p = frame.To(pts.x[iu], pts.y[iu]);
+    on_box += std::abs(p.x()) <= hl && std::abs(p.y()) <= hw;
+    lo_all = lo_all.cwiseMin(p);
+    hi_all = hi_all.cwiseMax(p);
+  }
+  if (lo) *lo = lo_all;
+  if (hi) *hi = hi_all;
+  return idx.empty() ? 0.0 : static_cast<double>(on_box) / static_cast<double>(idx.size());
+}
+
+// Items grouped by a key in [0, num_keys), each group in input order (a counting sort).
+struct Groups {
+  std::vector<std::size_t> start;  // group k is item[start[k], start[k + 1])
+  std::vector<std::size_t> item;
+  template <class KeyOf>
+  Groups(std::size_t num_items, std::size_t num_keys, KeyOf key_of)
+      : start(num_keys + 1, 0), item(num_items) {
+    for (std::size_t i = 0; i < num_items; ++i) ++start[key_of(i) + 1];
+    for (std::size_t k = 0; k < num_keys; ++k) start[k + 1] += start[k];
+    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t i = 0; i < num_items; ++i) item[fill[key_of(i)]++] = i;
+  }
+};
+
+}  // namespace
+
+std::vector<int> Associator::Assign(std::size_t nt, const std::vector<Pair>& pairs,
+                                    AssociationResult* out) {
+  // Connected components of the candidate graph: nodes 0..nt-1 tracks, nt.. parts; one
+  // minimum-cost assignment per component, with one "unassigned" column per track at miss_cost.
+  const std::size_t np = num_parts_;
+  const std::size_t nn = nt + np;
+  UnionFind uf(static_cast<int>(nn));
+  for (const Pair& pr : pairs) uf.Join(pr.track, static_cast<int>(nt) + pr.part);
+  std::vector<std::size_t> root(nn);
+  for (std::size_t k = 0; k < nn; ++k) root[k] = static_cast<std::size_t>(uf.Find(static_cast<int>(k)));
+  const Groups nodes(nn, nn, [&](std::size_t k) { return root[k]; });
+  const Groups comp_pairs(pairs.size(), nn, [&](std::size_t i) {
+    return root[static_cast<std::size_t>(pairs[i].track)];
+  });
+  std::vector<int> part_track(np, -1);
+  std::vector<int> ct, cp;
+  for (std::size_t c = 0; c < nn; ++c) {
+    ct.clear();
+    cp.clear();
+    for (std::size_t k = nodes.start[c]; k < nodes.start[c + 1]; ++k) {
+      const int node = static_cast<int>(nodes.item[k]);
+      if (node < static_cast<int>(nt)) ct.push_back(node);
+      else cp.push_back(node - static_cast<int>(nt));
+    }
+    if (ct.empty() || cp.empty()) continue;
+    AssignComponent(ct, cp, pairs, comp_pairs.item.data() + comp_pairs.start[c],
+                    comp_pairs.item.data() + comp_pairs.start[c + 1], &part_track, out);
+  }
+  return part_track;
+}
+
+void Associator::AssignComponent(const std::vector<int>& ct, const std::vector<int>& cp,
+                                 const std::vector<Pair>& pairs, const std::size_t* pair_begin,
+                                 const std::size_t* pair_end, std::vector<int>* part_track,
+                                 AssociationResult* out) {
+  const int rows = static_cast<int>(ct.size());
+  const int cols = static_cast<int>(cp.size()) + rows;  // + one "unassigned" column per row
+  row_of_.resize(out->track_points.size());
+  col_of_.resize(part_track->size());
+  for (int r = 0; r < rows; ++r) row_of_[static_cast<std::size_t>(ct[static_cast<std::size_t>(r)])] = r;
+  for (std::size_t k = 0; k < cp.size(); ++k) col_of_[static_cast<std::size_t>(cp[k])] = static_cast<int>(k);
+  cost_.assign(static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols), kForbidden);
+  for (int r = 0; r < rows; ++r) {
+    cost_[static_cast<std::size_t>(r) * cols + cp.size() + static_cast<std::size_t>(r)] = params_.miss_cost;
+  }
+  for (const std::size_t* k = pair_begin; k != pair_end; ++k) {
+    const Pair& pr = pairs[*k];
+    const int r = row_of_[static_cast<std::size_t>(pr.track)];
+    const int col = col_of_[static_cast<std::size_t>(pr.part)];
+    cost_[static_cast<std::size_t>(r) * cols + static_cast<std::size_t>(col)] = pr.cost;
+  }
+  const std::vector<int> assign = SolveAssignment(cost_, rows, cols);
+  for (int r = 0; r < rows; ++r) {
+    const int k = assign[static_cast<std::size_t>(r)];
+    if (k < 0 || k >= static_cast<int>(cp.size())) continue;
+    const double c_rk = cost_[static_cast<std::size_t>(r) * cols + static_cast<std::size_t>(k)];
+    if (c_rk >= kForbidden) continue;
+    const int j = ct[static_cast<std::size_t>(r)];
+    const int q = cp[static_cast<std::size_t>(k)];
+    (*part_track)[static_cast<std::size_t>(q)] = j;
+    out->track_cost[static_cast<std::size_t>(j)] = c_rk;
+    // The part is not read again once assigned: its returns move to the track.
+    std::swap(out->track_points[static_cast<std::size_t>(j)], parts_[static_cast<std::size_t>(q)].points);
+  }
+}
+
+Associator::MergeChoice Associator::ChooseMerge(const std::vector<PredictedObject>& tracks,
+                                                const WorldPoints& pts, const Part& part,
+                                                const std::vector<const Pair*>& part_pairs,
+                                                const AssociationResult& out) {
+  MergeChoice choice;
+  double best_inside = 0.0;
+  for (const Pair* pp : part_pairs) {
+    const Pair& pr = *pp;
+    choice.candidate = true;
+    // A piece of the same object lies on its rectangle (the gate without the growth for the
+    // position uncertainty) and does not stretch the object beyond the dimensions seen so far
+    // by more than gate_margin. The gate alone would take in a car parked 1 m away, whose
+    // returns then lengthen the shape estimate, which lengthens the rectangle and takes in the
+    // next car of the row.
+    const PredictedObject& t = tracks[static_cast<std::size_t>(pr.track)];
+    const BoxFrame frame(t.box);
+    Eigen::Vector2d lo_all, hi_all;
+    const double frac = FractionOnRectangle(t.box, params_.gate_margin, pts, part.points, &lo_all, &hi_all);
+    if (frac >= params_.min_inside_fraction) choice.on_some_box = true;
+    // What follows decides only whether this track takes the part: not if frac cannot win.
+    if (!(frac >= params_.merge_fraction && frac > best_inside)) continue;
+    const auto tu = static_cast<std::size_t>(pr.track);
+    const auto& own_points = out.track_points[tu];
+    if (own_points.empty()) continue;
+    // The track's own returns in its frame: computed once, again only after a merge into it.
+    if (!own_valid_[tu]) {
+      own_lo_[tu] = Eigen::Vector2d::Constant(kInf);
+      own_hi_[tu] = -own_lo_[tu];
+      for (const std::int32_t i : own_points) {
+        const auto iu = static_cast<std::size_t>(i);
+        const Eigen::Vector2d p = frame.To(pts.x[iu], pts.y[iu]);
+        own_lo_[tu] = own_lo_[tu].cwiseMin(p);
+        own_hi_[tu] = own_hi_[tu].cwiseMax(p);
+      }
+      own_valid_[tu] = 1;
+    }
+    const Eigen::Vector2d lo_own = own_lo_[tu], hi_own = own_hi_[tu];
+    lo_all = lo_all.cwiseMin(lo_own);
+    hi_all = hi_all.cwiseMax(hi_own);
+    const Eigen::Vector2d own = hi_own - lo_own, all = hi_all - lo_all;
+    const double max_l = (t.seen_length > 0.0 ? std::max(t.seen_length, own.x()) : t.box.length) +
+                         params_.gate_margin;
+    const double max_w = (t.seen_width > 0.0 ? std::max(t.seen_width, own.y()) : t.box.width) +
+                         params_.gate_margin;
+    if (all.x() > max_l || all.y() > max_w) continue;
+    best_inside = frac;
+    choice.track = pr.track;
+  }
+  return choice;
+}
+
+void Associator::Leftovers(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
+                           const Eigen::Vector2d& sensor_xy, const std::vector<Pair>& pairs,
+                           const std::vector<int>& part_track, AssociationResult* out) {
+  // Leftover parts: merge into an assigned track that holds most of them, else new objects.
+  const std::size_t nt = tracks.size();
+  const std::size_t np = num_parts_;
+  const Groups by_part(pairs.size(), np, [&](std::size_t i) {
+    return static_cast<std::size_t>(pairs[i].part);
+  });
+  own_valid_.assign(nt, 0);
+  own_lo_.resize(nt);
+  own_hi_.resize(nt);
+  std::vector<const Pair*> part_pairs;
+  for (std::size_t q = 0; q < np; ++q) {
+    if (part_track[q] >= 0) continue;
+    part_pairs.clear();
+    for (std::size_t k = by_part.start[q]; k < by_part.start[q + 1]; ++k) {
+      part_pairs.push_back(&pairs[by_part.item[k]]);
+    }
+    const MergeChoice choice = ChooseMerge(tracks, pts, parts_[q], part_pairs, *out);
+    if (choice.track >= 0) {
+      auto& dst = out->track_points[static_cast<std::size_t>(choice.track)];
+      dst.insert(dst.end(), parts_[q].points.begin(), parts_[q].points.end());
+      own_valid_[static_cast<std::size_t>(choice.track)] = 0;
+      ++out->num_merged;
+    } else if (choice.on_some_box ||
+               (choice.candidate && (parts_[q].max - parts_[q].min).norm() < params_.ignore_max_extent)) {
+      // On a track's rectangle (grown by gate_margin), or a small piece inside its gate (a
+      // column of returns off a side seen at a grazing angle), but not merged: not a new object
+      // (it would seed a duplicate of that track), not a measurement.
+      ++out->num_ignored;
+    } else if (!JoinMover(tracks, pts, sensor_xy, parts_[q].points, out, &own_valid_)) {
+      // A larger piece only inside the grown gate of a track (its position uncertainty):
+      // another object.
+      out->new_objects.push_back(std::move(parts_[q].points));
+    }
+  }
+}
+
 void Associator::Run(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
                      const Segments& segments, const Eigen::Vector2d& sensor_xy,
                      AssociationResult* out) {
@@ -560,210 +711,72 @@ void Associator::Run(const std::vector<PredictedObject>& tracks, const WorldPoin
   out->num_split = 0;
   out->num_merged = 0;
   out->num_ignored = 0;
-
+  // Split segments claimed by two or more established tracks.
   BuildParts(tracks, pts, segments);
-  out->num_split = static_cast<std::int32_t>(num_parts_) -
-                   static_cast<std::int32_t>(segments.segments.size());
-  if (out->num_split < 0) out->num_split = 0;
-  const std::size_t np = num_parts_;
+  out->num_split = std::max<std::int32_t>(
+      0, static_cast<std::int32_t>(num_parts_) - static_cast<std::int32_t>(segments.segments.size()));
+  // Candidate pairs, then one assignment per connected component.
+  CandidatePairs(tracks, pts, sensor_xy, &pairs_);
+  const std::vector<int> part_track = Assign(nt, pairs_, out);
+  // What is left: merged into a track, ignored, joined to a mover, or new objects.
+  Leftovers(tracks, pts, sensor_xy, pairs_, part_track, out);
+}
 
-  // Candidate pairs and their costs, in (track, part) order; each track's gate is tested only
-  // against the parts whose x range may overlap it.
-  struct Pair {
-    int track, part;
-    double cost, inside;
-  };
-  std::vector<Pair> pairs;
-  std::vector<double> margins(nt);
-  std::vector<Eigen::Vector2d> lo(nt), hi(nt);
-  {
-    std::vector<Eigen::Vector2d> part_lo(np), part_hi(np);
-    for (std::size_t q = 0; q < np; ++q) {
-      part_lo[q] = parts_[q].min;
-      part_hi[q] = parts_[q].max;
+void OrderNewObjects(const WorldPoints& pts, double small_extent,
+                     std::vector<std::vector<std::int32_t>>* objects) {
+  auto& objs = *objects;
+  std::vector<std::pair<std::pair<bool, std::size_t>, std::size_t>> order(objs.size());
+  for (std::size_t k = 0; k < objs.size(); ++k) {
+    Eigen::Vector2d lo = Eigen::Vector2d::Constant(kInf);
+    Eigen::Vector2d hi = -lo;
+    for (const std::int32_t i : objs[k]) {
+      const Eigen::Vector2d p(pts.x[static_cast<std::size_t>(i)], pts.y[static_cast<std::size_t>(i)]);
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
     }
-    sorted_.Build(part_lo, part_hi, {});
+    const bool small = objs[k].empty() || (hi - lo).norm() < small_extent;
+    order[k] = {{small, objs[k].size()}, k};
   }
-  const double slant = DegToRad(params_.min_slant_deg);
-  for (std::size_t j = 0; j < nt; ++j) {
-    margins[j] = GateMargin(tracks[j]);
-    GateBounds(tracks[j].box, margins[j], &lo[j], &hi[j]);
-    sorted_.Overlapping(lo[j], hi[j], &candidates_);
-    std::uint8_t visible = 0;
-    bool have_visible = false;
-    for (const std::int32_t qq : candidates_) {
-      const auto q = static_cast<std::size_t>(qq);
-      if (!have_visible) {
-        visible = VisibleFaces(tracks[j].box, sensor_xy, slant);
-        if (visible == 0) visible = 0xF;  // sensor inside or on the rectangle: any face
-        have_visible = true;
-      }
-      double inside = 0.0;
-      const double c = PairCost(tracks[j], margins[j], visible, parts_[q], pts, &inside);
-      if (std::isfinite(c)) pairs.push_back({static_cast<int>(j), static_cast<int>(q), c, inside});
-    }
-  }
+  std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) {
+    if (a.first.first != b.first.first) return !a.first.first;  // rectangles first
+    return a.first.second > b.first.second;
+  });
+  std::vector<std::vector<std::int32_t>> sorted(objs.size());
+  for (std::size_t k = 0; k < order.size(); ++k) sorted[k] = std::move(objs[order[k].second]);
+  objs.swap(sorted);
+}
 
-  // Connected components of the candidate graph: nodes 0..nt-1 tracks, nt.. parts. Members of
-  // each component (by root) and its pairs are listed by a counting sort, in index order.
-  const std::size_t nn = nt + np;
-  UnionFind uf(static_cast<int>(nn));
-  for (const Pair& pr : pairs) uf.Join(pr.track, static_cast<int>(nt) + pr.part);
-  std::vector<int> part_track(np, -1);
-  {
-    std::vector<int> root(nn);
-    std::vector<std::size_t> node_start(nn + 1, 0), pair_start(nn + 1, 0);
-    for (std::size_t k = 0; k < nn; ++k) {
-      root[k] = uf.Find(static_cast<int>(k));
-      ++node_start[static_cast<std::size_t>(root[k]) + 1];
-    }
-    for (const Pair& pr : pairs) ++pair_start[static_cast<std::size_t>(root[static_cast<std::size_t>(pr.track)]) + 1];
-    for (std::size_t c = 0; c < nn; ++c) {
-      node_start[c + 1] += node_start[c];
-      pair_start[c + 1] += pair_start[c];
-    }
-    std::vector<int> nodes(nn);
-    std::vector<const Pair*> comp_pairs(pairs.size());
-    {
-      std::vector<std::size_t> fill(node_start.begin(), node_start.end() - 1);
-      for (std::size_t k = 0; k < nn; ++k) nodes[fill[static_cast<std::size_t>(root[k])]++] = static_cast<int>(k);
-      fill.assign(pair_start.begin(), pair_start.end() - 1);
-      for (const Pair& pr : pairs) comp_pairs[fill[static_cast<std::size_t>(root[static_cast<std::size_t>(pr.track)])]++] = &pr;
-    }
-    std::vector<int> row_of(nt, -1), col_of(np, -1);
-    std::vector<int> ct, cp;
-    std::vector<double> cost;
-    for (std::size_t c = 0; c < nn; ++c) {
-      ct.clear();
-      cp.clear();
-      for (std::size_t k = node_start[c]; k < node_start[c + 1]; ++k) {
-        const int node = nodes[k];
-        if (node < static_cast<int>(nt)) ct.push_back(node);
-        else cp.push_back(node - static_cast<int>(nt));
-      }
-      if (ct.empty() || cp.empty()) continue;
-      const int rows = static_cast<int>(ct.size());
-      const int cols = static_cast<int>(cp.size()) + rows;  // + one "unassigned" column per row
-      for (int r = 0; r < rows; ++r) row_of[static_cast<std::size_t>(ct[static_cast<std::size_t>(r)])] = r;
-      for (std::size_t k = 0; k < cp.size(); ++k) col_of[static_cast<std::size_t>(cp[k])] = static_cast<int>(k);
-      // Not a candidate: far more than leaving the track unassigned, so never chosen.
-      const double kForbidden = 1e6;
-      cost.assign(static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols), kForbidden);
-      for (int r = 0; r < rows; ++r) {
-        cost[static_cast<std::size_t>(r) * cols + cp.size() + static_cast<std::size_t>(r)] = params_.miss_cost;
-      }
-      for (std::size_t k = pair_start[c]; k < pair_start[c + 1]; ++k) {
-        const Pair* pr = comp_pairs[k];
-        const int r = row_of[static_cast<std::size_t>(pr->track)];
-        const int col = col_of[static_cast<std::size_t>(pr->part)];
-        cost[static_cast<std::size_t>(r) * cols + static_cast<std::size_t>(col)] = pr->cost;
-      }
-      const std::vector<int> assign = SolveAssignment(cost, rows, cols);
-      for (int r = 0; r < rows; ++r) {
-        const int k = assign[static_cast<std::size_t>(r)];
-        if (k < 0 || k >= static_cast<int>(cp.size())) continue;
-        const double c_rk = cost[static_cast<std::size_t>(r) * cols + static_cast<std::size_t>(k)];
-        if (c_rk >= kForbidden) continue;
-        const int j = ct[static_cast<std::size_t>(r)];
-        const int q = cp[static_cast<std::size_t>(k)];
-        part_track[static_cast<std::size_t>(q)] = j;
-        out->track_cost[static_cast<std::size_t>(j)] = c_rk;
-        // The part is not read again once assigned: its returns move to the track.
-        std::swap(out->track_points[static_cast<std::size_t>(j)], parts_[static_cast<std::size_t>(q)].points);
-      }
-    }
-  }
+void CreatedRectangles::Clear() {
+  boxes_.clear();
+  lo_.clear();
+  hi_.clear();
+}
 
-  // The candidate pairs of each part, in pair order (counting sort).
-  std::vector<std::size_t> part_pair_start(np + 1, 0);
-  for (const Pair& pr : pairs) ++part_pair_start[static_cast<std::size_t>(pr.part) + 1];
-  for (std::size_t q = 0; q < np; ++q) part_pair_start[q + 1] += part_pair_start[q];
-  std::vector<const Pair*> part_pairs(pairs.size());
-  {
-    std::vector<std::size_t> fill(part_pair_start.begin(), part_pair_start.end() - 1);
-    for (const Pair& pr : pairs) part_pairs[fill[static_cast<std::size_t>(pr.part)]++] = &pr;
-  }
+void CreatedRectangles::Add(const OrientedBox& box) {
+  // Bounds of the rectangle grown by gate_margin, plus kBoundsSlack for rounding: an object
+  // whose bounding box misses them has no return inside and is not tested return by return.
+  Eigen::Vector2d lo, hi;
+  GateBounds(box, params_.gate_margin + kBoundsSlack, &lo, &hi);
+  boxes_.push_back(box);
+  lo_.push_back(lo);
+  hi_.push_back(hi);
+}
 
-  // Leftover parts: merge into an assigned track that holds most of them, else new objects.
-  std::vector<char> own_valid(nt, 0);
-  std::vector<Eigen::Vector2d> own_lo(nt), own_hi(nt);
-  for (std::size_t q = 0; q < np; ++q) {
-    if (part_track[q] >= 0) continue;
-    int best = -1;
-    double best_inside = 0.0;
-    bool on_some_box = false, candidate = false;
-    for (std::size_t k = part_pair_start[q]; k < part_pair_start[q + 1]; ++k) {
-      const Pair& pr = *part_pairs[k];
-      candidate = true;
-      // A piece of the same object lies on its rectangle (the gate without the growth for the
-      // position uncertainty) and does not stretch the object beyond the dimensions seen so far
-      // by more than gate_margin. The gate alone would take in a car parked 1 m away, whose
-      // returns then lengthen the shape estimate, which lengthens the rectangle and takes in the
-      // next car of the row.
-      const PredictedObject& t = tracks[static_cast<std::size_t>(pr.track)];
-      const BoxFrame frame(t.box);
-      const double hl = 0.5 * t.box.length + params_.gate_margin;
-      const double hw = 0.5 * t.box.width + params_.gate_margin;
-      Eigen::Vector2d lo_all = Eigen::Vector2d::Constant(kInf), hi_all = -lo_all;
-      int on_box = 0;
-      for (const std::int32_t i : parts_[q].points) {
-        const auto iu = static_cast<std::size_t>(i);
-        const Eigen::Vector2d p = frame.To(pts.x[iu], pts.y[iu]);
-        on_box += std::abs(p.x()) <= hl && std::abs(p.y()) <= hw;
-        lo_all = lo_all.cwiseMin(p);
-        hi_all = hi_all.cwiseMax(p);
-      }
-      const double frac = parts_[q].points.empty()
-                              ? 0.0
-                              : static_cast<double>(on_box) / static_cast<double>(parts_[q].points.size());
-      if (frac >= params_.min_inside_fraction) on_some_box = true;
-      // What follows decides only whether this track takes the part: not if frac cannot win.
-      if (!(frac >= params_.merge_fraction && frac > best_inside)) continue;
-      const auto tu = static_cast<std::size_t>(pr.track);
-      const auto& own_points = out->track_points[tu];
-      if (own_points.empty()) continue;
-      // The track's own returns in its frame: computed once, again only after a merge into it.
-      if (!own_valid[tu]) {
-        own_lo[tu] = Eigen::Vector2d::Constant(kInf);
-        own_hi[tu] = -own_lo[tu];
-        for (const std::int32_t i : own_points) {
-          const auto iu = static_cast<std::size_t>(i);
-          const Eigen::Vector2d p = frame.To(pts.x[iu], pts.y[iu]);
-          own_lo[tu] = own_lo[tu].cwiseMin(p);
-          own_hi[tu] = own_hi[tu].cwiseMax(p);
-        }
-        own_valid[tu] = 1;
-      }
-      const Eigen::Vector2d lo_own = own_lo[tu], hi_own = own_hi[tu];
-      lo_all = lo_all.cwiseMin(lo_own);
-      hi_all = hi_all.cwiseMax(hi_own);
-      const Eigen::Vector2d own = hi_own - lo_own, all = hi_all - lo_all;
-      const double max_l = (t.seen_length > 0.0 ? std::max(t.seen_length, own.x()) : t.box.length) +
-                           params_.gate_margin;
-      const double max_w = (t.seen_width > 0.0 ? std::max(t.seen_width, own.y()) : t.box.width) +
-                           params_.gate_margin;
-      if (all.x() > max_l || all.y() > max_w) continue;
-      if (frac >= params_.merge_fraction && frac > best_inside) {
-        best_inside = frac;
-        best = pr.track;
-      }
-    }
-    if (best >= 0) {
-      auto& dst = out->track_points[static_cast<std::size_t>(best)];
-      dst.insert(dst.end(), parts_[q].points.begin(), parts_[q].points.end());
-      own_valid[static_cast<std::size_t>(best)] = 0;
-      ++out->num_merged;
-    } else if (on_some_box || (candidate && (parts_[q].max - parts_[q].min).norm() < params_.ignore_max_extent)) {
-      // On a track's rectangle (grown by gate_margin), or a small piece inside its gate (a
-      // column of returns off a side seen at a grazing angle), but not merged: not a new object
-      // (it would seed a duplicate of that track), not a measurement.
-      ++out->num_ignored;
-    } else if (!JoinMover(tracks, pts, sensor_xy, parts_[q].points, out, &own_valid)) {
-      // A larger piece only inside the grown gate of a track (its position uncertainty):
-      // another object.
-      out->new_objects.push_back(std::move(parts_[q].points));
+bool CreatedRectangles::Holds(const WorldPoints& pts, const std::vector<std::int32_t>& idx) const {
+  if (boxes_.empty() || idx.empty()) return false;
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(kInf), hi = -lo;
+  for (const std::int32_t i : idx) {
+    const Eigen::Vector2d p(pts.x[static_cast<std::size_t>(i)], pts.y[static_cast<std::size_t>(i)]);
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  for (std::size_t c = 0; c < boxes_.size(); ++c) {
+    if (!Overlap(lo, hi, lo_[c], hi_[c])) continue;
+    if (FractionOnRectangle(boxes_[c], params_.gate_margin, pts, idx) >= params_.merge_fraction) {
+      return true;
     }
   }
+  return false;
 }
 
 }  // namespace vtrack

@@ -105,21 +105,6 @@ struct AssociationResult {
 // assignment is 60 lines that a brute-force test checks.
 std::vector<int> SolveAssignment(const std::vector<double>& cost, int rows, int cols);
 
-// Joins the pieces of faces seen at a grazing angle into one segment each (before association).
-// A 3-D scanner passing a parked row sees each car's side at a few degrees of incidence: one
-// column of returns per azimuth step, metres apart along the face (spacing ~ range^2 * step /
-// lateral offset: 1.4 m at 28 m for a 0.2 deg step and 2 m offset), each its own grid segment.
-// Tracked one by one they slide with the ego (a column stays at its bearing) and re-spawn as
-// new tracks. Two pieces (bounding-box diagonal < join_max_piece) are joined if their centroids
-// are within join_max_gap and the line between them is within join_max_deg of the ray to their
-// midpoint (a face seen nearly edge-on: a face seen at a larger slant is dense enough to be one
-// grid segment already); joins are made nearest first and refused if the joined bounding box
-// would exceed join_max_extent (cars of a row are 3 m apart and 4.5 m long: no chains). The
-// joined segment replaces the first piece, the others are removed; returns keep their order.
-// Returns the number of joins.
-int JoinGrazingPieces(const WorldPoints& pts, const Eigen::Vector2d& sensor_xy,
-                      const AssociationParams& params, Segments* segments);
-
 class Associator {
  public:
   explicit Associator(const AssociationParams& params);
@@ -129,6 +114,11 @@ class Associator {
 
   // Grown gate of a predicted object.
   double GateMargin(const PredictedObject& t) const;
+
+  // A rectangle's frame: centre, cos and sin of its heading, half length and half width.
+  struct RectFrame {
+    double cx, cy, ax, ay, hl, hw;
+  };
 
  private:
   struct Part {  // a segment, or one piece of a split segment
@@ -150,15 +140,51 @@ class Associator {
     void Overlapping(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi,
                      std::vector<std::int32_t>* ids) const;
   };
+  struct Pair {  // a candidate (track, part) and its cost
+    int track, part;
+    double cost, inside;
+  };
+  struct MergeChoice {  // what becomes of a leftover part
+    int track = -1;            // the track it merges into, or -1
+    bool on_some_box = false;  // on some track's rectangle (grown by gate_margin)
+    bool candidate = false;    // a candidate of some track
+  };
+
+  // Split: parts_ from the segments, a segment claimed by two or more established tracks split
+  // between them.
+  void BuildParts(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
+                  const Segments& segments);
+  void IndexClaimingGates(const std::vector<PredictedObject>& tracks);
+  void ClaimingTracks(const Segment& s, const WorldPoints& pts, const Segments& segments,
+                      std::vector<std::size_t>* claim);
+  void SplitAmong(const std::vector<PredictedObject>& tracks, const std::vector<std::size_t>& claim,
+                  const WorldPoints& pts, const std::int32_t* begin, const std::int32_t* end,
+                  std::size_t first);
+  std::size_t BoundParts(const WorldPoints& pts, std::size_t first, bool split);
+  // Candidate pairs with their costs, in (track, part) order.
+  void CandidatePairs(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
+                      const Eigen::Vector2d& sensor_xy, std::vector<Pair>* pairs);
+  // Cost of (track, part), or +inf if the part is not a candidate of the track.
+  double PairCost(const PredictedObject& t, double margin, std::uint8_t visible, const Part& p,
+                  const WorldPoints& pts, double* inside_fraction) const;
+  // The global assignment, per connected component; returns the track of each part (or -1).
+  std::vector<int> Assign(std::size_t num_tracks, const std::vector<Pair>& pairs,
+                          AssociationResult* out);
+  void AssignComponent(const std::vector<int>& tracks, const std::vector<int>& parts,
+                       const std::vector<Pair>& pairs, const std::size_t* pair_begin,
+                       const std::size_t* pair_end, std::vector<int>* part_track,
+                       AssociationResult* out);
+  // Merge, ignore, join a mover, or a new object: each part left unassigned.
+  void Leftovers(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
+                 const Eigen::Vector2d& sensor_xy, const std::vector<Pair>& pairs,
+                 const std::vector<int>& part_track, AssociationResult* out);
+  MergeChoice ChooseMerge(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
+                          const Part& part, const std::vector<const Pair*>& part_pairs,
+                          const AssociationResult& out);
   // A leftover piece joining a mover as its side seen edge-on (PredictedObject::rear_sign).
   bool JoinMover(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
                  const Eigen::Vector2d& sensor_xy, const std::vector<std::int32_t>& piece,
                  AssociationResult* out, std::vector<char>* own_valid) const;
-  void BuildParts(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
-                  const Segments& segments);
-  // Cost of (track, part), or +inf if the part is not a candidate of the track.
-  double PairCost(const PredictedObject& t, double margin, std::uint8_t visible, const Part& p,
-                  const WorldPoints& pts, double* inside_fraction) const;
 
   AssociationParams params_;
   // Scratch reused from scan to scan (no allocation per segment or part once warm).
@@ -166,10 +192,37 @@ class Associator {
   std::size_t num_parts_ = 0;
   SortedBoxes sorted_;
   std::vector<std::int32_t> candidates_;
-  struct Claimant {  // a track claiming part of a segment: frame and half sizes
-    double cx, cy, ax, ay, hl, hw;
-  };
-  std::vector<Claimant> claimants_;
+  std::vector<RectFrame> gates_;           // per track: frame, half sizes grown by its gate
+  std::vector<RectFrame> claimants_;       // the tracks claiming one segment
+  std::vector<Pair> pairs_;
+  std::vector<int> row_of_, col_of_;       // assignment: track -> row, part -> column
+  std::vector<double> cost_;               // assignment: cost matrix, row-major
+  std::vector<char> own_valid_;            // merge: own_lo_/own_hi_ of a track are current
+  std::vector<Eigen::Vector2d> own_lo_, own_hi_;  // merge: a track's returns in its frame
+};
+
+// New objects (what association left unassigned) in the order they become tracks: rectangles
+// before small objects (bounding-box diagonal < small_extent), each group largest first. A
+// car's end face seen edge-on at 30-40 m is a piece of a few returns beside its side, and may
+// hold more returns than the side: created first, it became a second track of the car, which
+// grew into a rectangle a few scans later and replaced the car's track (an identity switch).
+void OrderNewObjects(const WorldPoints& pts, double small_extent,
+                     std::vector<std::vector<std::int32_t>>* objects);
+
+// The rectangles of the tracks created from one scan. A new object with merge_fraction of its
+// returns on one of them (grown by gate_margin) is part of that object (a face cut off by a
+// range jump), not a new one: the same test as the merge of a leftover into a track.
+class CreatedRectangles {
+ public:
+  explicit CreatedRectangles(const AssociationParams& params) : params_(params) {}
+  void Clear();
+  void Add(const OrientedBox& box);
+  bool Holds(const WorldPoints& pts, const std::vector<std::int32_t>& idx) const;
+
+ private:
+  AssociationParams params_;
+  std::vector<OrientedBox> boxes_;
+  std::vector<Eigen::Vector2d> lo_, hi_;  // bounds of each grown rectangle
 };
 
 }  // namespace vtrack

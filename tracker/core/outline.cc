@@ -1,0 +1,156 @@
+#include "tracker/core/outline.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "tracker/core/angle.h"
+
+namespace vtrack {
+namespace {
+
+constexpr std::int64_t kBinScale = std::int64_t{1} << 32;  // key = bin * kBinScale + range^2
+
+// The bin of a key bin * 2^32 + range^2 (range^2 < 2^32, bin of either sign).
+std::int64_t BinOf(std::int64_t key) {
+  return key >= 0 ? key / kBinScale : -((-key + kBinScale - 1) / kBinScale);
+}
+
+// Bins are uniform in tan(bearing - ref): this bounds tan for returns beside or behind the
+// sensor (they fall in the outermost bins).
+constexpr double kMaxTan = 1e6;
+// A return this near the sensor's line across the reference direction is beside the sensor.
+constexpr double kMinAlong = 1e-6;  // [m]
+
+}  // namespace
+
+void OutlineExtractor::Extract(const WorldPoints& points, const std::vector<std::int32_t>& idx,
+                               const LadarScan& scan, const Eigen::Vector2d& sensor_xy,
+                               PointSet* out) {
+  const bool multi_ring = scan.num_rings > 1;
+  Eigen::Vector2d lo, hi;
+  Gather(points, idx, scan, out, &lo, &hi);
+  out->outline = multi_ring && params_.bin_deg > 0.0;
+  const double res = DegToRad(params_.bin_deg);
+  if (!(res > 0.0 && out->x.size() > 1)) return;
+  const Eigen::Vector2d s = sensor_xy - out->origin;
+  const Eigen::Vector2d mid = 0.5 * (lo + hi) - out->origin - s;
+  SortByBin(*out, s, mid.normalized(), res);
+  outline_x_.clear();
+  outline_y_.clear();
+  PickPerBin(points, idx, *out, multi_ring ? params_.support_height : 0.0);
+  if (outline_x_.empty() && multi_ring && params_.support_height > 0.0 &&
+      LongestRingSpan(points, idx) >= params_.arc_span) {
+    PickPerBin(points, idx, *out, 0.0);
+  }
+  out->x.assign(outline_x_.begin(), outline_x_.end());
+  out->y.assign(outline_y_.begin(), outline_y_.end());
+}
+
+void OutlineExtractor::Gather(const WorldPoints& points, const std::vector<std::int32_t>& idx,
+                              const LadarScan& scan, PointSet* ps, Eigen::Vector2d* lo_out,
+                              Eigen::Vector2d* hi_out) const {
+  ps->x.resize(idx.size());
+  ps->y.resize(idx.size());
+  const std::size_t i0 = static_cast<std::size_t>(idx.front());
+  ps->origin = Eigen::Vector2d(std::round(points.x[i0]), std::round(points.y[i0]));
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector2d hi = -lo;
+  double dt_sum = 0.0;
+  const bool has_dt = scan.dt_us.size() == scan.size();
+  for (std::size_t k = 0; k < idx.size(); ++k) {
+    const auto i = static_cast<std::size_t>(idx[k]);
+    const Eigen::Vector2d p(points.x[i], points.y[i]);
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+    ps->x[k] = static_cast<float>(p.x() - ps->origin.x());
+    ps->y[k] = static_cast<float>(p.y() - ps->origin.y());
+    if (has_dt) dt_sum += scan.dt_us[static_cast<std::size_t>(points.index[i])];
+  }
+  ps->extent = (hi - lo).norm();
+  ps->mean_utime = scan.utime + static_cast<std::int64_t>(std::llround(dt_sum / idx.size()));
+  *lo_out = lo;
+  *hi_out = hi;
+}
+
+void OutlineExtractor::SortByBin(const PointSet& ps, const Eigen::Vector2d& s,
+                                 const Eigen::Vector2d& ref, double bin_rad) {
+  // Bins uniform in tan(bearing - ref) (no atan2 per return; within +-30 deg of the segment's
+  // middle, as wide as bin_rad to within 33%); the key orders by bin, then range^2.
+  const double inv_res = 1.0 / std::tan(bin_rad);
+  keys_.clear();
+  for (std::size_t k = 0; k < ps.x.size(); ++k) {
+    const double dx = ps.x[k] - s.x(), dy = ps.y[k] - s.y();
+    const double u = dx * ref.x() + dy * ref.y(), w = -dx * ref.y() + dy * ref.x();
+    const double t = u > kMinAlong ? w / u : (w >= 0 ? kMaxTan : -kMaxTan);
+    const auto bin = static_cast<std::int64_t>(std::floor(std::clamp(t, -kMaxTan, kMaxTan) * inv_res));
+    const auto r2 = static_cast<std::int64_t>((dx * dx + dy * dy) * 1e4);  // [cm^2]
+    keys_.emplace_back(bin * kBinScale + r2, static_cast<std::int32_t>(k));
+  }
+  std::sort(keys_.begin(), keys_.end());
+}
+
+double OutlineExtractor::RangeOf(std::size_t a) const {
+  return std::sqrt(static_cast<double>(keys_[a].first - BinOf(keys_[a].first) * kBinScale) * 1e-4);
+}
+
+void OutlineExtractor::PickPerBin(const WorldPoints& points, const std::vector<std::int32_t>& idx,
+                                  const PointSet& ps, double support_h) {
+  const double support_r = params_.support_range;
+  auto height = [&](std::size_t a) {
+    return points.height[static_cast<std::size_t>(idx[static_cast<std::size_t>(keys_[a].second)])];
+  };
+  std::size_t k = 0;
+  while (k < keys_.size()) {
+    std::size_t end = k + 1;
+    while (end < keys_.size() && BinOf(keys_[end].first) == BinOf(keys_[k].first)) ++end;
+    std::size_t pick = k;
+    if (support_h > 0.0) {
+      pick = end;
+      for (std::size_t a = k; a < end && pick == end; ++a) {
+        const double ra = RangeOf(a);
+        const float ha = height(a);
+        for (std::size_t b = k; b < end; ++b) {
+          if (b == a) continue;
+          const double rb = RangeOf(b);
+          if (rb > ra + support_r) break;  // sorted by range
+          if (std::abs(rb - ra) <= support_r && std::abs(height(b) - ha) >= support_h) {
+            pick = a;
+            break;
+          }
+        }
+      }
+    }
+    if (pick < end) {
+      const auto src = static_cast<std::size_t>(keys_[pick].second);
+      outline_x_.push_back(ps.x[src]);
+      outline_y_.push_back(ps.y[src]);
+    }
+    k = end;
+  }
+}
+
+double OutlineExtractor::LongestRingSpan(const WorldPoints& points,
+                                         const std::vector<std::int32_t>& idx) {
+  // Rings grazing a bonnet and a roof hit them at different ranges, each at its own one range:
+  // the span is taken per ring.
+  ring_span_.clear();
+  double span = 0.0;
+  for (std::size_t a = 0; a < keys_.size(); ++a) {
+    const auto i = static_cast<std::size_t>(idx[static_cast<std::size_t>(keys_[a].second)]);
+    const std::int16_t ring = points.ring[i];
+    const double r = RangeOf(a);
+    auto it = std::find_if(ring_span_.begin(), ring_span_.end(),
+                           [&](const RingSpan& e) { return e.ring == ring; });
+    if (it == ring_span_.end()) {
+      ring_span_.push_back({ring, r, r});
+    } else {
+      it->lo = std::min(it->lo, r);
+      it->hi = std::max(it->hi, r);
+      span = std::max(span, it->hi - it->lo);
+    }
+  }
+  return span;
+}
+
+}  // namespace vtrack

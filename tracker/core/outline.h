@@ -1,0 +1,79 @@
+// The returns of one track (or one new object) as the fit wants them (paper Section 2.4): in a
+// local frame, with their mean measurement time and, for 3-D clouds, reduced to the outline the
+// sensor sees.
+//
+// The outline: per bearing bin (bin_deg, seen from the sensor) the nearest return. A 3-D cloud
+// also holds roofs, windows and returns stacked in columns; the edge / corner fit wants the
+// visible outline, as a single-plane scanner gives it. It also bounds the fit's cost.
+//
+// 3-D clouds: the outline takes, per bin, the nearest return that stands on a vertical face:
+// another return of the bin lies within support_range of its range at a height differing by
+// support_height or more. A ring that grazes a horizontal surface (a roof, a bonnet) hits it at
+// a fixed distance from the sensor, so those returns move with the ego vehicle; fitted as an
+// edge they make a parked car look like a mover. Faces are hit by several rings at nearly the
+// same range. Unless no bin of the segment has such support and the returns of one ring span
+// more than arc_span of range: one ring seen over something nearer (the roof line of a car
+// behind another), which a grazed roof or bonnet, at one range, cannot give. Then the nearest
+// return per bin.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "tracker/core/preprocess.h"
+#include "tracker/core/scan.h"
+#include "tracker/core/track.h"
+
+namespace vtrack {
+
+struct OutlineParams {
+  double bin_deg = 0.2;          // [deg] bearing bin of the outline; 0: every return
+  double support_height = 0.1;   // [m] 3-D: height difference that makes a vertical face; 0: off
+  double support_range = 0.25;   // [m] 3-D: range difference within which returns support
+  double arc_span = 1.0;         // [m] 3-D: one ring's range span that makes an unsupported
+                                 //     segment a face seen over something nearer (0: any)
+};
+
+class OutlineExtractor {
+ public:
+  explicit OutlineExtractor(const OutlineParams& params) : params_(params) {}
+
+  // Fills *out with the returns idx (non-empty, indices into points) of scan: relative to an
+  // origin near them (floats keep full precision far from the world origin), their mean
+  // measurement time, extent, and the outline seen from sensor_xy. out->size() is 0 if a 3-D
+  // segment has no return on a vertical face (only roofs: nothing to fit).
+  void Extract(const WorldPoints& points, const std::vector<std::int32_t>& idx,
+               const LadarScan& scan, const Eigen::Vector2d& sensor_xy, PointSet* out);
+
+ private:
+  // Copies the returns into out's local frame; their bounding box (local) in *lo, *hi.
+  void Gather(const WorldPoints& points, const std::vector<std::int32_t>& idx,
+              const LadarScan& scan, PointSet* out, Eigen::Vector2d* lo,
+              Eigen::Vector2d* hi) const;
+  // Sorts the returns by bearing bin, then range, into keys_.
+  void SortByBin(const PointSet& ps, const Eigen::Vector2d& sensor, const Eigen::Vector2d& ref,
+                 double bin_rad);
+  // Appends to outline_x_/y_ per bin the nearest return with support (support_height > 0), or
+  // the nearest return (support_height 0).
+  void PickPerBin(const WorldPoints& points, const std::vector<std::int32_t>& idx,
+                  const PointSet& ps, double support_height);
+  // The largest range span of one ring's returns.
+  double LongestRingSpan(const WorldPoints& points, const std::vector<std::int32_t>& idx);
+  // Range [m] of keys_[a].
+  double RangeOf(std::size_t a) const;
+
+  OutlineParams params_;
+  // Scratch reused from segment to segment.
+  std::vector<std::pair<std::int64_t, std::int32_t>> keys_;  // (bin * 2^32 + range^2 [cm^2], k)
+  std::vector<float> outline_x_, outline_y_;
+  struct RingSpan {
+    std::int16_t ring;
+    double lo, hi;  // [m] range of the ring's returns in a segment
+  };
+  std::vector<RingSpan> ring_span_;
+};
+
+}  // namespace vtrack

@@ -1,0 +1,190 @@
+#include "tracker/core/sequencing.h"
+
+#include <algorithm>
+#include <utility>
+
+namespace vtrack {
+namespace {
+
+std::string Str(std::int64_t v) { return std::to_string(v); }
+
+// A rotation matrix R has R^T R = I; a mounting or pose further from it than this (Frobenius
+// norm) is refused: far beyond the rounding of a rotation sent as floats, far below any real
+// shear or scale.
+constexpr double kMaxRotationError = 1e-3;
+
+// A jump in the sensor's scan seq larger than this is a renumbered sensor, not scans lost.
+constexpr std::uint64_t kMaxSeqGap = 100'000;
+
+bool IsRotation(const Eigen::Matrix3d& R) {
+  return (R.transpose() * R - Eigen::Matrix3d::Identity()).norm() <= kMaxRotationError;
+}
+
+}  // namespace
+
+void RejectCounter::Count(const std::string& reason, std::int64_t count,
+                          const std::string& message) {
+  if (count <= 0) return;
+  counts_[reason] += count;
+  if (events_.size() < kMaxEvents) events_.push_back({reason, message});
+}
+
+void RejectCounter::Event(const std::string& reason, const std::string& message) {
+  events_.push_back({reason, message});
+}
+
+std::vector<TrackerEvent> RejectCounter::TakeEvents() {
+  std::vector<TrackerEvent> e;
+  e.swap(events_);
+  return e;
+}
+
+ScanSequencer::ScanSequencer(const InputParams& params, std::int64_t max_coast_us,
+                             std::int64_t max_points, RejectCounter* rejects)
+    : params_(params),
+      max_coast_us_(max_coast_us),
+      max_points_(max_points),
+      rejects_(rejects),
+      poses_(params.pose_history_us) {}
+
+void ScanSequencer::Reset(const std::string& why) {
+  ++resets_;
+  scans_dropped_ += static_cast<std::int64_t>(queue_.size());
+  queue_.clear();
+  poses_.Clear();
+  have_scan_ = false;
+  have_time_ = false;
+  have_seq_ = false;
+  rejects_->Event("reset", "tracker reset: " + why);
+}
+
+bool ScanSequencer::CheckTime(std::int64_t utime, const char* what) {
+  if (have_time_ && utime < latest_utime_ - params_.time_jump_reset_us) {
+    Reset(std::string(what) + " time jumped back by " +
+          Str((latest_utime_ - utime) / 1000) + " ms (looped log?)");
+    latest_utime_ = utime;
+    have_time_ = true;
+    return true;
+  }
+  // A jump forward longer than any track may coast (a clock step, a log that skips ahead): no
+  // track can survive it, and predicting them across it would only let stale tracks (with huge
+  // covariances) catch the new returns.
+  const std::int64_t forward_us = std::max(params_.time_jump_reset_us, max_coast_us_);
+  if (have_time_ && utime > latest_utime_ + forward_us) {
+    Reset(std::string(what) + " time jumped forward by " + Str((utime - latest_utime_) / 1000) + " ms");
+    latest_utime_ = utime;
+    have_time_ = true;
+    return true;
+  }
+  if (!have_time_ || utime > latest_utime_) latest_utime_ = utime;
+  have_time_ = true;
+  return false;
+}
+
+ScanSequencer::Admission ScanSequencer::AddPose(const EgoPose& pose) {
+  ++poses_received_;
+  Admission a;
+  if (!pose.world_from_body.matrix().allFinite() || !IsRotation(pose.world_from_body.linear())) {
+    rejects_->Count("invalid_pose", 1,
+                    "pose at " + Str(pose.utime) + " is not finite or not a rotation");
+    return a;
+  }
+  a.reset = CheckTime(pose.utime, "pose");
+  switch (poses_.Add(pose.utime, pose.world_from_body)) {
+    case PoseHistory::AddResult::kOk: break;
+    case PoseHistory::AddResult::kDuplicate:
+      rejects_->Count("pose_repeated", 1, "pose at " + Str(pose.utime) + " repeats the previous time");
+      return a;
+    case PoseHistory::AddResult::kOutOfOrder:
+      rejects_->Count("pose_out_of_order", 1,
+                      "pose at " + Str(pose.utime) + " is older than " + Str(poses_.newest_utime()));
+      return a;
+  }
+  a.accepted = true;
+  return a;
+}
+
+void ScanSequencer::CountSeqGap(std::int64_t seq) {
+  // Scans lost on the way (LCM drops a datagram, or a fragmented message with a fragment
+  // missing, without a word) show as gaps in the sensor's seq: one count per missing scan.
+  if (have_seq_ && seq > last_seq_) {
+    const std::uint64_t gap = static_cast<std::uint64_t>(seq) - static_cast<std::uint64_t>(last_seq_) - 1;
+    if (gap > 0 && gap <= kMaxSeqGap) {
+      rejects_->Count("scan_seq_gap", static_cast<std::int64_t>(gap),
+                      Str(static_cast<std::int64_t>(gap)) + " scans missing before scan " + Str(seq));
+    }
+  }
+  if (!have_seq_ || seq > last_seq_) last_seq_ = seq;
+  have_seq_ = true;
+}
+
+std::string ScanSequencer::CheckScan(const LadarScan& scan, const char** reason) const {
+  const std::size_t n = scan.x.size();
+  *reason = "bad_scan";
+  if (scan.y.size() != n || scan.z.size() != n ||
+      (!scan.dt_us.empty() && scan.dt_us.size() != n) ||
+      (!scan.ring.empty() && scan.ring.size() != n)) {
+    return "arrays of different lengths";
+  }
+  if (scan.sweep_duration_us < 0 || scan.sweep_duration_us > params_.max_sweep_duration_us) {
+    return "sweep_duration_us " + Str(scan.sweep_duration_us) + " out of range";
+  }
+  if (!scan.body_from_sensor.matrix().allFinite()) return "mounting pose is not finite";
+  if (!IsRotation(scan.body_from_sensor.linear())) return "mounting orientation is not a rotation";
+  if (n == 0) {
+    *reason = "empty_scan";
+    return "no returns";
+  }
+  if (static_cast<std::int64_t>(n) > max_points_) {
+    *reason = "huge_scan";
+    return Str(static_cast<std::int64_t>(n)) + " returns > max_points " + Str(max_points_);
+  }
+  return "";
+}
+
+ScanSequencer::Admission ScanSequencer::AddScan(LadarScan&& scan) {
+  ++scans_received_;
+  CountSeqGap(scan.seq);
+  Admission a;
+  auto drop = [&](const char* reason, const std::string& msg) {
+    ++scans_dropped_;
+    rejects_->Count(reason, 1, "scan " + Str(scan.seq) + " at " + Str(scan.utime) + ": " + msg);
+    return a;
+  };
+  const char* reason = "";
+  if (const std::string why = CheckScan(scan, &reason); !why.empty()) return drop(reason, why);
+  a.reset = CheckTime(scan.utime, "scan");
+  if (have_scan_ && scan.utime <= last_scan_utime_) {
+    return drop(scan.utime == last_scan_utime_ ? "scan_repeated" : "scan_out_of_order",
+                "not after the previous scan at " + Str(last_scan_utime_));
+  }
+  last_scan_utime_ = scan.utime;
+  have_scan_ = true;
+  if (static_cast<int>(queue_.size()) >= params_.max_queued_scans) {
+    ++scans_dropped_;
+    rejects_->Count("scan_overrun", 1, "scan queue full (no pose for " + Str(queue_.size()) +
+                                           " scans): dropped scan at " + Str(queue_.front().utime));
+    queue_.pop_front();
+  }
+  queue_.push_back(std::move(scan));
+  a.accepted = true;
+  return a;
+}
+
+const LadarScan* ScanSequencer::Ready(bool flush, bool* extrapolate) const {
+  if (queue_.empty()) return nullptr;
+  const LadarScan& s = queue_.front();
+  const bool ready = !poses_.empty() && poses_.newest_utime() >= s.end_utime();
+  const bool forced = flush || latest_utime_ >= s.end_utime() + params_.max_pose_wait_us;
+  if (!ready && !forced) return nullptr;
+  *extrapolate = !ready;
+  return &s;
+}
+
+void ScanSequencer::Done(bool processed) {
+  if (processed) ++scans_processed_;
+  else ++scans_dropped_;
+  queue_.pop_front();
+}
+
+}  // namespace vtrack

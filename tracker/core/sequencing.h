@@ -1,0 +1,104 @@
+// Sequencing of the tracker's input, by message time only (never the wall clock). Poses go into
+// a PoseHistory. Scans wait in a queue, in order, until the pose stream has reached the scan's
+// last return time (utime + sweep_duration_us), so that every return is compensated with an
+// interpolated pose. If the poses stall, a scan is released anyway once any message is
+// max_pose_wait_us later than that time, with the pose extrapolated.
+//
+// Bad input is refused and counted by reason (RejectCounter): malformed scans and poses, scans
+// out of time order or repeated, scans lost on the way (gaps in the sensor's seq), a full
+// queue. A message more than time_jump_reset_us older than the newest one (a looped log), or
+// newer than the newest by more than any track may coast, resets the input: queue and poses are
+// cleared, and the caller clears its tracks.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "tracker/core/pose.h"
+#include "tracker/core/scan.h"
+#include "tracker/core/tracker_params.h"
+
+namespace vtrack {
+
+// Something the adapter should warn about (rate-limited); the reason is the counter key.
+struct TrackerEvent {
+  std::string reason;
+  std::string message;
+};
+
+// What was refused, counted by reason, and the events to warn about.
+class RejectCounter {
+ public:
+  // Adds count (nothing if <= 0) to reason's counter and keeps the message for a warning.
+  void Count(const std::string& reason, std::int64_t count, const std::string& message);
+  // An event that is not a refusal (a reset).
+  void Event(const std::string& reason, const std::string& message);
+  const std::map<std::string, std::int64_t>& counts() const { return counts_; }
+  std::vector<TrackerEvent> TakeEvents();
+
+ private:
+  // Events kept between two TakeEvents() at the most: a flood of bad input must not grow them
+  // without bound while the adapter is not reading them.
+  static constexpr std::size_t kMaxEvents = 1000;
+  std::map<std::string, std::int64_t> counts_;
+  std::vector<TrackerEvent> events_;
+};
+
+class ScanSequencer {
+ public:
+  // max_coast_us: the longest any track may coast; a jump forward beyond it (and beyond
+  // time_jump_reset_us) resets. max_points: larger scans are refused ("huge_scan").
+  ScanSequencer(const InputParams& params, std::int64_t max_coast_us, std::int64_t max_points,
+                RejectCounter* rejects);
+
+  struct Admission {
+    bool accepted = false;  // queued (a scan) or added (a pose)
+    bool reset = false;     // the message's time jumped: the input was reset before it
+  };
+  Admission AddPose(const EgoPose& pose);
+  Admission AddScan(LadarScan&& scan);
+
+  // The oldest queued scan if it may be processed now (flush: whatever the poses), else
+  // nullptr. *extrapolate: the pose stream has not reached the scan's end.
+  const LadarScan* Ready(bool flush, bool* extrapolate) const;
+  // Removes the scan Ready() gave, counting it processed or dropped.
+  void Done(bool processed);
+
+  const PoseHistory& poses() const { return poses_; }
+  std::int64_t scans_received() const { return scans_received_; }
+  std::int64_t scans_processed() const { return scans_processed_; }
+  std::int64_t scans_dropped() const { return scans_dropped_; }
+  std::int64_t poses_received() const { return poses_received_; }
+  std::int64_t resets() const { return resets_; }
+  std::int64_t latest_utime() const { return latest_utime_; }
+  std::size_t queued_scans() const { return queue_.size(); }
+
+ private:
+  // Counts a gap in the sensor's scan seq as scans lost on the way.
+  void CountSeqGap(std::int64_t seq);
+  // "" if the scan is well formed, else why not (its reject reason in *reason).
+  std::string CheckScan(const LadarScan& scan, const char** reason) const;
+  // Follows the newest message time; true if utime jumped and the input was reset.
+  bool CheckTime(std::int64_t utime, const char* what);
+  void Reset(const std::string& why);
+
+  InputParams params_;
+  std::int64_t max_coast_us_ = 0;
+  std::int64_t max_points_ = 0;
+  RejectCounter* rejects_;
+  PoseHistory poses_;
+  std::deque<LadarScan> queue_;
+  std::int64_t latest_utime_ = 0;
+  bool have_time_ = false;
+  std::int64_t last_scan_utime_ = 0;
+  bool have_scan_ = false;
+  std::int64_t last_seq_ = 0;  // newest scan seq received (for scan_seq_gap)
+  bool have_seq_ = false;
+  std::int64_t scans_received_ = 0, scans_processed_ = 0, scans_dropped_ = 0;
+  std::int64_t poses_received_ = 0, resets_ = 0;
+};
+
+}  // namespace vtrack

@@ -2,6 +2,7 @@
 // (swapped inputs, a merged segment split between two cars, a car cut in two by an occluder,
 // a new object, and the preference for returns on the visible faces).
 #include "tracker/core/association.h"
+#include "tracker/core/grazing_pieces.h"
 
 #include <gtest/gtest.h>
 
@@ -254,7 +255,7 @@ TEST(JoinGrazingPiecesTest, ColumnsOfEachParkedCarBecomeOneSegmentWithoutChainin
   // Without joining, the cars 23-38 m away fall apart into columns.
   for (int k = 1; k < 3; ++k) EXPECT_GE(segments_of_car[static_cast<std::size_t>(k)].size(), 3u) << "car " << k;
   const std::size_t returns = s.segments.point.size();
-  const int joins = JoinGrazingPieces(s.pts, sensor, AssociationParams{}, &s.segments);
+  const int joins = JoinGrazingPieces(s.pts, sensor, GrazingJoinParams{}, &s.segments);
   EXPECT_GT(joins, 0);
   EXPECT_EQ(s.segments.point.size(), returns);  // no return lost or duplicated
   Tally(s, &cars_of_segment, &segments_of_car);
@@ -292,13 +293,13 @@ TEST(JoinGrazingPiecesTest, PiecesSideBySideAcrossTheRayOrTooFarApartStaySeparat
   }
   Segments segs = SegmentsOf(pts, {{0, 4}, {4, 8}, {8, 12}, {12, 16}});
   for (auto& g : segs.segments) g.centroid = 0.5 * (g.min + g.max);
-  EXPECT_EQ(JoinGrazingPieces(pts, sensor, AssociationParams{}, &segs), 0);
+  EXPECT_EQ(JoinGrazingPieces(pts, sensor, GrazingJoinParams{}, &segs), 0);
   EXPECT_EQ(segs.segments.size(), 4u);
   // Joining off: nothing changes even for the parked row.
   RowScene s = ParkedRow(sensor);
   const std::size_t n = s.segments.segments.size();
-  AssociationParams off;
-  off.join_max_piece = 0.0;
+  GrazingJoinParams off;
+  off.max_piece = 0.0;
   EXPECT_EQ(JoinGrazingPieces(s.pts, sensor, off, &s.segments), 0);
   EXPECT_EQ(s.segments.segments.size(), n);
 }

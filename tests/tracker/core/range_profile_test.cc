@@ -2,7 +2,7 @@
 // built by hand whose answer follows from the geometry: a face ends in free space, behind a low
 // object near the sensor that only the downward rings hit, behind a real occluder on the face's
 // rings, or continues at the same range.
-#include "tracker/core/track_manager.h"
+#include "tracker/core/range_profile.h"
 
 #include <gtest/gtest.h>
 

@@ -50,6 +50,27 @@ LadarScan ScanFromLcm(ladar_scan_t&& msg) {
   return s;
 }
 
+DetectionList DetectionsFromLcm(const detection_list_t& msg) {
+  DetectionList out;
+  out.utime = msg.utime;
+  out.seq = msg.seq;
+  out.boxes.reserve(msg.detections.size());
+  for (const detection_t& d : msg.detections) {
+    Detection b;
+    b.x = d.x;
+    b.y = d.y;
+    b.z = d.z;
+    b.yaw = d.yaw;
+    b.length = d.length;
+    b.width = d.width;
+    b.height = d.height;
+    b.score = d.score;
+    b.object_class = d.object_class;
+    out.boxes.push_back(b);
+  }
+  return out;
+}
+
 EgoPose PoseFromLcm(const pose_t& msg) {
   EgoPose p;
   p.utime = msg.utime;

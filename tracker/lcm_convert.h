@@ -7,6 +7,7 @@
 #include "tracker/core/scan.h"
 #include "tracker/core/tracker.h"
 #include "vtrack/ladar_scan_t.hpp"
+#include "vtrack/detection_list_t.hpp"
 #include "vtrack/pose_t.hpp"
 #include "vtrack/track_debug_t.hpp"
 #include "vtrack/track_list_t.hpp"
@@ -18,6 +19,9 @@ LadarScan ScanFromLcm(ladar_scan_t&& msg);
 // A quaternion within 1e-3 of unit length is normalised; others are passed on as they are and
 // refused by the core as "invalid_pose".
 EgoPose PoseFromLcm(const pose_t& msg);
+
+// A detector's boxes as the core takes them.
+DetectionList DetectionsFromLcm(const detection_list_t& msg);
 
 track_t TrackToLcm(const TrackReport& r);
 track_list_t TrackListToLcm(const ScanOutput& out, const std::string& mode, std::int64_t latency_us);

@@ -62,6 +62,9 @@ int RunLive(const TrackerParams& params, const NodeOptions& options, const std::
   LiveHandler handler(&node);
   lcm->subscribe(options.scan_channel, &LiveHandler::OnMessage, &handler);
   lcm->subscribe(options.pose_channel, &LiveHandler::OnMessage, &handler);
+  if (params.detections.mode != InputMode::kScans) {
+    lcm->subscribe(options.detections_channel, &LiveHandler::OnMessage, &handler);
+  }
   std::fprintf(stderr, "vtrack-tracker: live on %s, mode %s, %s + %s -> %s%s\n", url.c_str(),
                ToString(params.manager.mode), options.scan_channel.c_str(),
                options.pose_channel.c_str(), options.tracks_channel.c_str(),
@@ -140,7 +143,7 @@ int RunOffline(const TrackerParams& params, const NodeOptions& options, const st
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string config, mode, input, output, url;
+  std::string config, mode, input_mode, input, output, url;
   NodeOptions options;
   double status_period = 1.0;
   po::options_description desc(
@@ -151,6 +154,9 @@ int main(int argc, char** argv) {
       ("config", po::value(&config)->default_value(VTRACK_DEFAULT_TRACKER_CONFIG),
        "tracker parameters (YAML, see config/tracker.yaml); empty: built-in defaults")
       ("mode", po::value(&mode), "mht (default) | ism | vasm: overrides the config's manager.mode")
+      ("input-mode", po::value(&input_mode),
+       "scans (default) | boxes | fused: what tracks are measured with (LADAR_SCAN, a detector's "
+       "DETECTIONS, or both); overrides the config's detections.mode")
       ("input", po::value(&input), "LCM log to track offline, as fast as possible")
       ("output", po::value(&output), "LCM log to write (with --input): TRACKS, TRACKER_STATUS, TRACK_DEBUG")
       ("debug", po::bool_switch(&options.debug), "also publish TRACK_DEBUG (large)")
@@ -159,6 +165,8 @@ int main(int argc, char** argv) {
        "is appended to udpm:// URLs that lack it")
       ("scan-channel", po::value(&options.scan_channel)->default_value("LADAR_SCAN"), "input scans")
       ("pose-channel", po::value(&options.pose_channel)->default_value("EGO_POSE"), "input ego poses")
+      ("detections-channel", po::value(&options.detections_channel)->default_value("DETECTIONS"),
+       "input detector boxes (input modes boxes and fused)")
       ("tracks-channel", po::value(&options.tracks_channel)->default_value("TRACKS"), "output tracks")
       ("debug-channel", po::value(&options.debug_channel)->default_value("TRACK_DEBUG"), "output debug")
       ("status-channel", po::value(&options.status_channel)->default_value("TRACKER_STATUS"), "output status")
@@ -197,6 +205,10 @@ int main(int argc, char** argv) {
     }
     if (vm.count("mode") && !ParseTrackerMode(mode, &params.manager.mode)) {
       std::cerr << "vtrack-tracker: --mode '" << mode << "' must be mht, ism or vasm\n";
+      return 2;
+    }
+    if (vm.count("input-mode") && !ParseInputMode(input_mode, &params.detections.mode)) {
+      std::cerr << "vtrack-tracker: --input-mode '" << input_mode << "' must be scans, boxes or fused\n";
       return 2;
     }
     std::string error;

@@ -48,6 +48,22 @@ void TrackerNode::Handle(const std::string& channel, const void* data, std::size
         return;
       }
       tracker_.AddPose(PoseFromLcm(msg), &outs_);
+    } else if (channel == options_.detections_channel &&
+               params_.detections.mode != InputMode::kScans) {
+      detection_list_t msg;
+      std::string why;
+      const auto err = lcm_util::Decode(data, size, &msg, &why);
+      if (err != lcm_util::DecodeError::kNone) {
+        ++decode_errors_;
+        ++decode_reasons_[lcm_util::DecodeErrorName(err)];
+        log_.Warn(lcm_util::DecodeErrorName(err),
+                  "dropped a " + channel + " message: " + lcm_util::DecodeErrorName(err) +
+                      (why.empty() ? "" : " (" + why + ")"));
+        return;
+      }
+      arrival_.emplace_back(msg.utime, lcm_util::WallUtime());
+      if (arrival_.size() > 1000) arrival_.pop_front();
+      tracker_.AddDetections(DetectionsFromLcm(msg), &outs_);
     } else {
       return;
     }

@@ -22,6 +22,7 @@ namespace vtrack {
 struct NodeOptions {
   std::string scan_channel = "LADAR_SCAN";
   std::string pose_channel = "EGO_POSE";
+  std::string detections_channel = "DETECTIONS";  // read in the input modes boxes and fused
   std::string tracks_channel = "TRACKS";
   std::string debug_channel = "TRACK_DEBUG";
   std::string status_channel = "TRACKER_STATUS";

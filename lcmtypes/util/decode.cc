@@ -3,6 +3,8 @@
 #include <cstring>
 #include <string>
 
+#include "vtrack/detection_list_t.hpp"
+#include "vtrack/detection_t.hpp"
 #include "vtrack/hypothesis_t.hpp"
 #include "vtrack/ladar_scan_t.hpp"
 #include "vtrack/object_list_t.hpp"
@@ -122,6 +124,14 @@ bool WalkObjectList(Walker& w) {
          w.Skip(static_cast<std::size_t>(n) * obj, "object_list_t.objects");
 }
 
+bool WalkDetectionList(Walker& w) {
+  std::int32_t n = 0;
+  const std::size_t det = FixedSize<detection_t>();
+  return w.Skip(8 + 8, "detection_list_t.utime/seq") && w.SkipString("detection_list_t.source") &&
+         w.ReadCount(&n, det, "detection_list_t.num_detections") &&
+         w.Skip(static_cast<std::size_t>(n) * det, "detection_list_t.detections");
+}
+
 bool WalkTrack(Walker& w) {
   // Everything before npred is fixed: the default message (npred = 0) minus the npred field.
   const std::size_t head = FixedSize<track_t>() - 4;
@@ -194,6 +204,10 @@ bool CheckLengths(std::int64_t fingerprint, const void* data, std::size_t size, 
     ok = WalkLadarScan(w);
   } else if (fingerprint == object_list_t::getHash()) {
     ok = WalkObjectList(w);
+  } else if (fingerprint == detection_list_t::getHash()) {
+    ok = WalkDetectionList(w);
+  } else if (fingerprint == detection_t::getHash()) {
+    ok = w.Skip(FixedSize<detection_t>(), "detection_t");
   } else if (fingerprint == track_t::getHash()) {
     ok = WalkTrack(w);
   } else if (fingerprint == track_list_t::getHash()) {

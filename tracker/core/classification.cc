@@ -12,12 +12,12 @@ MoverTest::MoverTest(double confidence, double min_speed)
       d1_quantile_(ChiSquareQuantile(confidence, 1)),
       min_speed_(min_speed) {}
 
-std::optional<bool> MoverTest::Evidence(const Ekf& ekf, const Track& t) const {
+std::optional<bool> MoverTest::Evidence(const Ekf& ekf, const Track& t, bool pose_measured) const {
   const TrackHypothesis& sel = t.hyps[static_cast<std::size_t>(t.selected)];
-  if (!sel.has_fit) return std::nullopt;
+  if (!sel.has_fit && !pose_measured) return std::nullopt;
   const CentreEstimate c = ekf.Centre(sel.filter);
   const Eigen::Matrix2d C = 0.5 * (c.velocity_cov + c.velocity_cov.transpose());
-  if (sel.fit.kind == FitKind::kEdge && c.velocity.allFinite()) {
+  if (!pose_measured && sel.fit.kind == FitKind::kEdge && c.velocity.allFinite()) {
     const Eigen::Vector2d n(-std::sin(sel.fit.phi), std::cos(sel.fit.phi));
     const double vn = n.dot(c.velocity), var = n.dot(C * n);
     return var > 0.0 && vn * vn / var > d1_quantile_ && std::abs(vn) >= min_speed_;
@@ -32,6 +32,7 @@ std::optional<bool> MoverTest::Evidence(const Ekf& ekf, const Track& t) const {
 
 ObjectClass Classify(const TrackManagerParams& params, const Track& t) {
   if (t.small_object) return ObjectClass::kOther;
+  if (t.box_updates > 0) return ObjectClass::kVehicle;
   const TrackHypothesis& sel = t.hyps[static_cast<std::size_t>(t.selected)];
   const double est_l = sel.length_est.value_or(0.0), est_w = sel.width_est.value_or(0.0);
   const bool vehicle_size = est_l <= params.vehicle_max_length &&

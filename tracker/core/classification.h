@@ -19,8 +19,9 @@ class MoverTest {
  public:
   MoverTest(double confidence, double min_speed);
   // Evidence of motion on this scan; nullopt without a fit (a centroid slides with the view
-  // just the same, so it is no evidence either way).
-  std::optional<bool> Evidence(const Ekf& ekf, const Track& t) const;
+  // just the same, so it is no evidence either way). pose_measured: the scan measured the
+  // whole pose (a detector's box): the 2-dof test.
+  std::optional<bool> Evidence(const Ekf& ekf, const Track& t, bool pose_measured = false) const;
 
  private:
   double d2_quantile_ = 0.0;  // chi-square quantile, 2 dof
@@ -30,7 +31,8 @@ class MoverTest {
 
 // The class of t: a vehicle if its estimated size (not the default lower bound) fits a vehicle,
 // or a face of a car's front or rear width was seen whole and the rest fits, or it is a mover of
-// any plausible size; otherwise other. Small objects are other.
+// any plausible size, or a vehicle detector's box measured it; otherwise other. Small objects
+// are other.
 ObjectClass Classify(const TrackManagerParams& params, const Track& t);
 
 }  // namespace vtrack

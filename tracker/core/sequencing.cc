@@ -1,6 +1,7 @@
 #include "tracker/core/sequencing.h"
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 namespace vtrack {
@@ -51,6 +52,8 @@ void ScanSequencer::Reset(const std::string& why) {
   ++resets_;
   scans_dropped_ += static_cast<std::int64_t>(queue_.size());
   queue_.clear();
+  detections_.clear();
+  have_detections_ = false;
   poses_.Clear();
   have_scan_ = false;
   have_time_ = false;
@@ -169,6 +172,52 @@ ScanSequencer::Admission ScanSequencer::AddScan(LadarScan&& scan) {
   queue_.push_back(std::move(scan));
   a.accepted = true;
   return a;
+}
+
+ScanSequencer::Admission ScanSequencer::AddDetections(DetectionList&& list) {
+  ++detections_received_;
+  Admission a;
+  for (const Detection& d : list.boxes) {
+    const bool finite = std::isfinite(d.x) && std::isfinite(d.y) && std::isfinite(d.z) &&
+                        std::isfinite(d.yaw) && std::isfinite(d.score);
+    if (!finite || !(d.length > 0.0) || !(d.width > 0.0) || !(d.height > 0.0)) {
+      rejects_->Count("bad_detections", 1, "detections " + Str(list.seq) + " at " + Str(list.utime) +
+                                               ": a box is not finite or not of positive size");
+      return a;
+    }
+  }
+  a.reset = CheckTime(list.utime, "detections");
+  if (have_detections_ && list.utime <= last_detections_utime_) {
+    rejects_->Count(list.utime == last_detections_utime_ ? "detections_repeated" : "detections_out_of_order",
+                    1, "detections at " + Str(list.utime) + " not after the previous ones at " +
+                           Str(last_detections_utime_));
+    return a;
+  }
+  last_detections_utime_ = list.utime;
+  have_detections_ = true;
+  if (static_cast<int>(detections_.size()) >= params_.max_queued_scans) {
+    rejects_->Count("detections_overrun", 1, "detection queue full: dropped detections at " +
+                                                 Str(detections_.front().utime));
+    detections_.pop_front();
+  }
+  detections_.push_back(std::move(list));
+  a.accepted = true;
+  return a;
+}
+
+const DetectionList* ScanSequencer::ReadyDetections(bool flush, bool* extrapolate) const {
+  if (detections_.empty()) return nullptr;
+  const DetectionList& d = detections_.front();
+  const bool ready = !poses_.empty() && poses_.newest_utime() >= d.utime;
+  const bool forced = flush || latest_utime_ >= d.utime + params_.max_pose_wait_us;
+  if (!ready && !forced) return nullptr;
+  *extrapolate = !ready;
+  return &d;
+}
+
+void ScanSequencer::DoneDetections(bool processed) {
+  if (processed) ++detections_processed_;
+  detections_.pop_front();
 }
 
 const LadarScan* ScanSequencer::Ready(bool flush, bool* extrapolate) const {

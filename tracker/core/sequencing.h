@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "tracker/core/detections.h"
 #include "tracker/core/pose.h"
 #include "tracker/core/scan.h"
 #include "tracker/core/tracker_params.h"
@@ -60,12 +61,17 @@ class ScanSequencer {
   };
   Admission AddPose(const EgoPose& pose);
   Admission AddScan(LadarScan&& scan);
+  // A detector's boxes wait like a scan whose sweep ends at their utime.
+  Admission AddDetections(DetectionList&& list);
 
   // The oldest queued scan if it may be processed now (flush: whatever the poses), else
   // nullptr. *extrapolate: the pose stream has not reached the scan's end.
   const LadarScan* Ready(bool flush, bool* extrapolate) const;
   // Removes the scan Ready() gave, counting it processed or dropped.
   void Done(bool processed);
+  // The same for detection lists.
+  const DetectionList* ReadyDetections(bool flush, bool* extrapolate) const;
+  void DoneDetections(bool processed);
 
   const PoseHistory& poses() const { return poses_; }
   std::int64_t scans_received() const { return scans_received_; }
@@ -75,6 +81,8 @@ class ScanSequencer {
   std::int64_t resets() const { return resets_; }
   std::int64_t latest_utime() const { return latest_utime_; }
   std::size_t queued_scans() const { return queue_.size(); }
+  std::int64_t detections_received() const { return detections_received_; }
+  std::int64_t detections_processed() const { return detections_processed_; }
 
  private:
   // Counts a gap in the sensor's scan seq as scans lost on the way.
@@ -91,6 +99,10 @@ class ScanSequencer {
   RejectCounter* rejects_;
   PoseHistory poses_;
   std::deque<LadarScan> queue_;
+  std::deque<DetectionList> detections_;
+  std::int64_t last_detections_utime_ = 0;
+  bool have_detections_ = false;
+  std::int64_t detections_received_ = 0, detections_processed_ = 0;
   std::int64_t latest_utime_ = 0;
   bool have_time_ = false;
   std::int64_t last_scan_utime_ = 0;

@@ -60,6 +60,7 @@ struct Track {
   bool small_object = false;              // measured by centroid (poles, bushes, pedestrians)
   bool axis_from_full_face = false;       // heading set by a fully seen short face (AlignToFullFace)
   double full_face_extent = 0.0;          // [m] that face's extent (a car's front or rear width)
+  int box_updates = 0;                    // [-] updates (and creation) by a detector's box
   std::vector<TrackHypothesis> hyps;
   int selected = 0;                       // index into hyps of the reported hypothesis
 };

@@ -201,7 +201,7 @@ void TrackManager::Update(std::size_t index, const PointSet& points,
   }
   SelectHypothesis(params_.switch_margin, &t);
   ReseedFailedHypotheses(ekf_, params_.fail_misses, &t);
-  if (any) TestMotion(&t);
+  if (any) TestMotion(&t, /*pose_measured=*/false);
   if (any && !t.mover && !t.small_object && profile && !profile->empty()) {
     AlignToFullFace(ekf_, params_, points, sensor_xy, seed, *profile, &measurer_, &t);
   }
@@ -266,32 +266,37 @@ bool TrackManager::UpdateHypothesis(const Track& t, bool parked, const PointSet&
                                     const Eigen::Vector2d& sensor_xy, std::uint64_t seed,
                                     double time_s, TrackHypothesis* h) {
   h->updated_this_scan = false;
-  const MotionModel& model = ekf_.model(h->filter.kind);
-  const Eigen::Vector3d pose = PoseOf(model, h->filter.x);
+  const Eigen::Vector3d pose = PoseOf(ekf_.model(h->filter.kind), h->filter.x);
   CentreMeasurement m;
+  // Same request for every hypothesis but the heading and the shape: the seed is shared so
+  // hypotheses that agree get the same fit.
+  const bool measured =
+      measurer_.Measure(t.small_object, points, sensor_xy, seed, pose(2),
+                        parked ? std::optional<Eigen::Vector2d>(pose.head<2>()) : std::nullopt,
+                        h, &m);
+  if (ApplyMeasurement(measured ? &m : nullptr, h)) ObserveShape(t.small_object, points, time_s, h);
+  return h->updated_this_scan;
+}
+
+bool TrackManager::ApplyMeasurement(const CentreMeasurement* m, TrackHypothesis* h) {
   // The score term of a scan without an accepted update: as if the measurement had landed on
   // the gate (track_manager.h, "Score").
   double term = 0.5 * (ekf_.gate_nis() + h->last_logdet);
-  // Same request for every hypothesis but the heading and the shape: the seed is shared so
-  // hypotheses that agree get the same fit.
-  if (measurer_.Measure(t.small_object, points, sensor_xy, seed, pose(2),
-                        parked ? std::optional<Eigen::Vector2d>(pose.head<2>()) : std::nullopt,
-                        h, &m)) {
-    const auto idx = model.PoseIndices();
+  if (m) {
+    const auto idx = ekf_.model(h->filter.kind).PoseIndices();
     Eigen::Matrix3d S;
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) S(r, c) = h->filter.P(idx[r], idx[c]);
-    S += m.R;
+    S += m->R;
     const double det = (2.0 * kPi * S).determinant();
     const double logdet = det > 0.0 ? std::log(det) : h->last_logdet;
-    const UpdateResult res = ekf_.Update(m, &h->filter);
+    const UpdateResult res = ekf_.Update(*m, &h->filter);
     if (res.accepted) {
       term = 0.5 * (res.nis + logdet);
       h->last_logdet = logdet;
       h->last_nis = res.nis;
       h->consecutive_misses = 0;
       h->updated_this_scan = true;
-      ObserveShape(t.small_object, points, time_s, h);
     } else {
       term = 0.5 * (ekf_.gate_nis() + logdet);
     }
@@ -326,8 +331,8 @@ void TrackManager::ObserveShape(bool small, const PointSet& points, double time_
   h->RefreshShape();
 }
 
-void TrackManager::TestMotion(Track* t) const {
-  const std::optional<bool> evidence = mover_test_.Evidence(ekf_, *t);
+void TrackManager::TestMotion(Track* t, bool pose_measured) const {
+  const std::optional<bool> evidence = mover_test_.Evidence(ekf_, *t, pose_measured);
   if (!evidence) return;  // no evidence either way: the count is kept
   t->motion_evidence = *evidence ? t->motion_evidence + 1 : 0;
   if (!t->mover && t->motion_evidence >= params_.mover_scans) {
@@ -341,6 +346,76 @@ void TrackManager::TestMotion(Track* t) const {
   if (t->mover && params_.mode == TrackerMode::kMht && t->hyps.size() == 1 && !t->small_object) {
     SpawnVasms(ekf_, params_, t);
   }
+}
+
+void TrackManager::UpdateWithBox(std::size_t index, const BoxMeasurement& b,
+                                 const DetectionParams& dp) {
+  Track& t = tracks_[index];
+  const std::int64_t tm = std::max(b.utime, t.state_utime);
+  const double dt = static_cast<double>(tm - t.state_utime) * 1e-6;
+  for (auto& h : t.hyps) {
+    if (dt > 0.0) ekf_.Predict(dt, h.noise_scale, &h.filter);
+  }
+  t.state_utime = tm;
+  const double time_s = static_cast<double>(tm) * 1e-6;
+  bool any = false;
+  for (TrackHypothesis& h : t.hyps) {
+    h.updated_this_scan = false;
+    h.has_fit = false;
+    const double theta = PoseOf(ekf_.model(h.filter.kind), h.filter.x)(2);
+    const CentreMeasurement m = BoxToMeasurement(b, theta, dp);
+    if (ApplyMeasurement(&m, &h)) {
+      ObserveBoxShape(b, time_s, &h);
+      any = true;
+    }
+  }
+  if (any) {
+    ++t.num_updates;
+    ++t.box_updates;
+    t.consecutive_misses = 0;
+    t.last_update_utime = tm;
+  } else {
+    ++t.consecutive_misses;
+  }
+  SelectHypothesis(params_.switch_margin, &t);
+  ReseedFailedHypotheses(ekf_, params_.fail_misses, &t);
+  if (any) TestMotion(&t, /*pose_measured=*/true);
+}
+
+void TrackManager::ObserveBoxShape(const BoxMeasurement& b, double time_s,
+                                   TrackHypothesis* h) const {
+  // The box's length lies along the hypothesis' axis (its heading is taken modulo 180 deg, not
+  // 90): a detector's box is a full view of both.
+  h->shape.AddLength(time_s, b.box.length);
+  h->shape.AddWidth(time_s, b.box.width);
+  h->length_seen_full = true;
+  h->width_seen_full = true;
+  h->RefreshShape();
+}
+
+bool TrackManager::CreateFromBox(const BoxMeasurement& b, const DetectionParams& dp) {
+  Track t;
+  TrackHypothesis h;
+  h.shape = ShapeEstimator(shape_params_);
+  h.inside_fraction = params_.mode == TrackerMode::kVasm && !params_.vasm_variants.empty()
+                          ? params_.vasm_variants[0].inside_fraction
+                          : params_.ism_inside_fraction;
+  const CentreMeasurement m = BoxToMeasurement(b, b.box.theta, dp);
+  if (!m.z.allFinite() || !(b.box.length > 0.0) || !(b.box.width > 0.0)) return false;
+  h.filter = ekf_.InitIsm(m);
+  if (params_.mode == TrackerMode::kVasm) h.filter = ekf_.Convert(h.filter, ModelKind::kVasm, 0.0);
+  ObserveBoxShape(b, static_cast<double>(b.utime) * 1e-6, &h);
+  h.last_logdet = std::log(std::max(1e-300, (2.0 * kPi * m.R).determinant()));
+  h.score_terms.push_back(0.5 * (3.0 + h.last_logdet));
+  t.id = next_id_++;
+  t.created_utime = b.utime;
+  t.state_utime = b.utime;
+  t.last_update_utime = b.utime;
+  t.num_updates = 1;
+  t.box_updates = 1;
+  t.hyps.push_back(std::move(h));
+  tracks_.push_back(std::move(t));
+  return true;
 }
 
 OrientedBox TrackManager::Box(std::size_t index) const {

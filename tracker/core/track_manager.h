@@ -72,6 +72,7 @@
 #include "tracker/core/association.h"
 #include "tracker/core/box.h"
 #include "tracker/core/classification.h"
+#include "tracker/core/detections.h"
 #include "tracker/core/ekf.h"
 #include "tracker/core/fitting.h"
 #include "tracker/core/measurement.h"
@@ -97,6 +98,10 @@ class TrackManager {
               std::uint64_t seed, TrackDebug* debug, const RangeProfile* profile = nullptr);
   // The reported rectangle of a track at its state time.
   OrientedBox Box(std::size_t index) const;
+  // Updates track index with a detector's box (detections.h).
+  void UpdateWithBox(std::size_t index, const BoxMeasurement& box, const DetectionParams& dp);
+  // A new track from a detector's box.
+  bool CreateFromBox(const BoxMeasurement& box, const DetectionParams& dp);
   // Marks a track without returns on this scan.
   void Miss(std::size_t index);
   // A new track from returns that no track claimed. Returns false if they cannot be measured.
@@ -125,8 +130,13 @@ class TrackManager {
   // The shape estimate's observations after an accepted update, and on creation.
   void ObserveShape(bool small, const PointSet& points, double time_s, TrackHypothesis* h) const;
   void ObserveFirstShape(bool small, const PointSet& points, TrackHypothesis* h) const;
-  // The mover test on this scan, and what follows a mover declaration.
-  void TestMotion(Track* t) const;
+  // The mover test on this scan, and what follows a mover declaration. pose_measured: the
+  // update measured the whole pose (a detector's box), not a fit of the returns.
+  void TestMotion(Track* t, bool pose_measured) const;
+  // The score term and the filter update of one hypothesis with m (nullptr: nothing measured);
+  // true if the update was accepted.
+  bool ApplyMeasurement(const CentreMeasurement* m, TrackHypothesis* h);
+  void ObserveBoxShape(const BoxMeasurement& b, double time_s, TrackHypothesis* h) const;
   bool Parked(const Track& t) const;
   void FillDebug(const Track& t, const PointSet& points, const Eigen::Vector2d& sensor_xy,
                  TrackDebug* debug) const;

@@ -62,6 +62,7 @@ bool TrackerParams::Validate(std::string* error) const {
     return e.empty();
   };
   return input.Validate(error) && local(preprocess.FirstProblem()) &&
+         local(detections.FirstProblem()) &&
          local(segmentation.FirstProblem()) && local(association.FirstProblem()) &&
          fit.Validate(error) && ism.Validate(error) && vasm.Validate(error) &&
          ekf.Validate(error) && shape.Validate(error) && manager.Validate(error);
@@ -89,7 +90,15 @@ void Tracker::AddPose(const EgoPose& pose, std::vector<ScanOutput>* out) {
 }
 
 void Tracker::AddScan(LadarScan&& scan, std::vector<ScanOutput>* out) {
+  if (params_.detections.mode == InputMode::kBoxes) return;  // boxes only: scans are not used
   const ScanSequencer::Admission a = sequencer_.AddScan(std::move(scan));
+  if (a.reset) manager_->Clear();
+  if (a.accepted) ProcessReady(false, out);
+}
+
+void Tracker::AddDetections(DetectionList&& list, std::vector<ScanOutput>* out) {
+  if (params_.detections.mode == InputMode::kScans) return;  // scans only: boxes are not used
+  const ScanSequencer::Admission a = sequencer_.AddDetections(std::move(list));
   if (a.reset) manager_->Clear();
   if (a.accepted) ProcessReady(false, out);
 }
@@ -97,13 +106,57 @@ void Tracker::AddScan(LadarScan&& scan, std::vector<ScanOutput>* out) {
 void Tracker::Flush(std::vector<ScanOutput>* out) { ProcessReady(true, out); }
 
 void Tracker::ProcessReady(bool flush, std::vector<ScanOutput>* out) {
-  bool extrapolate = false;
-  while (const LadarScan* scan = sequencer_.Ready(flush, &extrapolate)) {
+  // Scans and detection lists in time order: a list goes first if it describes a time no later
+  // than the scan's last return.
+  for (;;) {
+    bool scan_extrapolate = false, boxes_extrapolate = false;
+    const LadarScan* scan = sequencer_.Ready(flush, &scan_extrapolate);
+    const DetectionList* boxes = sequencer_.ReadyDetections(flush, &boxes_extrapolate);
+    if (!scan && !boxes) return;
     ScanOutput o;
-    const bool processed = Process(*scan, extrapolate, &o);
+    if (boxes && (!scan || boxes->utime <= scan->end_utime())) {
+      const bool processed = ProcessDetections(*boxes, boxes_extrapolate, &o);
+      // Boxes only: each list is answered; fused: the scans answer.
+      if (processed && params_.detections.mode == InputMode::kBoxes) out->push_back(std::move(o));
+      sequencer_.DoneDetections(processed);
+      continue;
+    }
+    const bool processed = Process(*scan, scan_extrapolate, &o);
     if (processed) out->push_back(std::move(o));
     sequencer_.Done(processed);
   }
+}
+
+bool Tracker::ProcessDetections(const DetectionList& list, bool extrapolate, ScanOutput* out) {
+  PoseHistory::LookupStatus status = PoseHistory::LookupStatus::kOk;
+  const std::optional<Eigen::Isometry3d> pose = sequencer_.poses().At(
+      list.utime, extrapolate ? params_.input.max_extrapolation_us : 0, &status);
+  if (!pose) {
+    rejects_.Count(status == PoseHistory::LookupStatus::kTooFarAhead ? "stale_pose" : "pose_missing", 1,
+                   "detections " + Str(list.seq) + " at " + Str(list.utime) + ": no pose");
+    return false;
+  }
+  const DetectionParams& dp = params_.detections;
+  const std::vector<BoxMeasurement> boxes = BoxesInWorld(list, *pose, dp);
+  manager_->Predict(list.utime, &predicted_);
+  const BoxAssociation assoc = AssociateBoxes(predicted_, boxes, dp);
+  const bool boxes_only = dp.mode == InputMode::kBoxes;
+  for (std::size_t j = 0; j < assoc.track_box.size(); ++j) {
+    const int k = assoc.track_box[j];
+    if (k >= 0) manager_->UpdateWithBox(j, boxes[static_cast<std::size_t>(k)], dp);
+    else if (boxes_only) manager_->Miss(j);  // fused: a scan decides whether it was missed
+  }
+  for (const int k : assoc.new_boxes) {
+    const BoxMeasurement& b = boxes[static_cast<std::size_t>(k)];
+    if (b.score >= dp.birth_score) manager_->CreateFromBox(b, dp);
+  }
+  if (boxes_only) {
+    manager_->EndScan(list.utime);
+    manager_->Report(list.utime, &out->tracks);
+  }
+  out->utime = list.utime;
+  out->seq = list.seq;
+  return true;
 }
 
 bool Tracker::Process(const LadarScan& scan, bool extrapolate, ScanOutput* out) {

@@ -53,6 +53,8 @@ class Tracker {
   // Each may process queued scans; their outputs are appended to *out in scan order.
   void AddPose(const EgoPose& pose, std::vector<ScanOutput>* out);
   void AddScan(LadarScan&& scan, std::vector<ScanOutput>* out);
+  // A detector's boxes (used in the input modes boxes and fused, ignored with scans only).
+  void AddDetections(DetectionList&& list, std::vector<ScanOutput>* out);
   void Flush(std::vector<ScanOutput>* out);
 
   // Counters since construction.
@@ -75,6 +77,9 @@ class Tracker {
   void ProcessReady(bool flush, std::vector<ScanOutput>* out);
   // The per-scan pipeline; false if the scan could not be placed in the world.
   bool Process(const LadarScan& scan, bool extrapolate, ScanOutput* out);
+  // A detector's boxes: association by centre distance, box updates, new tracks; with boxes
+  // only also the life cycle and the report. False if no pose places them.
+  bool ProcessDetections(const DetectionList& list, bool extrapolate, ScanOutput* out);
   // Compensation and ground; false (counted) if no pose covers the sweep.
   bool Preprocess(const LadarScan& scan, bool extrapolate, PreprocessResult* pre);
   // Updates every track with its returns (a miss if none).

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "tracker/core/association.h"
+#include "tracker/core/detections.h"
 #include "tracker/core/ekf.h"
 #include "tracker/core/fitting.h"
 #include "tracker/core/ism.h"
@@ -50,6 +51,7 @@ struct TrackerParams {
   EkfParams ekf;
   ShapeParams shape;
   TrackManagerParams manager;  // includes the mode (mht | ism | vasm)
+  DetectionParams detections;  // a detector's boxes: the input mode and their measurement model
 
   // True if every component is valid; otherwise false and *error names the key and its value.
   bool Validate(std::string* error) const;

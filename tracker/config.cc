@@ -109,14 +109,14 @@ class Section {
 void Read(const YAML::Node& root, const std::string& origin, TrackerParams* p) {
   static const std::set<std::string> kSections = {
       "input", "preprocess", "segmentation", "association", "fit",
-      "ism",   "vasm",       "ekf",          "shape",       "manager"};
+      "ism",   "vasm",       "ekf",          "shape",       "manager", "detections"};
   if (!root.IsMap() && !root.IsNull()) throw std::runtime_error(origin + ": top level is not a mapping");
   for (const auto& kv : root) {
     const std::string s = kv.first.as<std::string>();
     if (!kSections.count(s)) {
       throw std::runtime_error(origin + ": " + s +
                                " is not a known section (input, preprocess, segmentation, "
-                               "association, fit, ism, vasm, ekf, shape, manager)");
+                               "association, fit, ism, vasm, ekf, shape, manager, detections)");
     }
   }
   {
@@ -283,6 +283,23 @@ void Read(const YAML::Node& root, const std::string& origin, TrackerParams* p) {
     s.Get("vehicle_max_width", &q.vehicle_max_width);
     s.Get("prediction_horizon_s", &q.prediction_horizon_s);
     s.Get("prediction_step_s", &q.prediction_step_s);
+    s.Done();
+  }
+  {
+    Section s(root, "detections", origin);
+    auto& q = p->detections;
+    std::string mode = ToString(q.mode);
+    s.Get("mode", &mode);
+    if (!ParseInputMode(mode, &q.mode)) {
+      throw std::runtime_error(origin + ": detections.mode = '" + mode + "': must be scans, boxes or fused");
+    }
+    s.Get("min_score", &q.min_score);
+    s.Get("birth_score", &q.birth_score);
+    s.Get("position_std", &q.position_std);
+    s.Get("heading_std_deg", &q.heading_std_deg);
+    s.Get("gate_m", &q.gate_m);
+    s.Get("gate_sigma", &q.gate_sigma);
+    s.Get("max_gate_m", &q.max_gate_m);
     s.Done();
   }
   std::string error;

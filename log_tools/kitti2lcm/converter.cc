@@ -16,7 +16,8 @@ std::string ConvertOptions::Validate() const {
   else if (num_frames == 0 || num_frames < -1) os << "num_frames must be >= 1 (or -1 = all), got " << num_frames;
   else if (pose_period_us < 1000 || pose_period_us > 100000)
     os << "pose_period_us must be in [1000, 100000] us (10-1000 Hz), got " << pose_period_us;
-  else if (scan_channel.empty() || pose_channel.empty() || truth_channel.empty())
+  else if (scan_channel.empty() || pose_channel.empty() || truth_channel.empty() ||
+           detections_channel.empty())
     os << "channel names must not be empty";
   return os.str();
 }
@@ -34,8 +35,11 @@ ConvertStats ConvertSequence(const Sequence& seq, const ConvertOptions& options,
   const int total = last - first + 1;
 
   // Pose times: a regular grid over the converted sweeps, plus every frame's own time.
-  const std::int64_t t0 = seq.ScanUtime(first);
-  const std::int64_t t1 = seq.ScanUtime(last) + seq.options().velodyne.sweep_duration_us;
+  // Without scans the poses cover the frames' times only.
+  const std::int64_t t0 = seq.has_scans() ? seq.ScanUtime(first) : seq.FrameUtime(first);
+  const std::int64_t t1 = seq.has_scans()
+                              ? seq.ScanUtime(last) + seq.options().velodyne.sweep_duration_us
+                              : seq.FrameUtime(last);
   std::set<std::int64_t> pose_times;
   for (std::int64_t t = t0; t <= t1; t += options.pose_period_us) pose_times.insert(t);
   for (int i = first; i <= last; ++i) pose_times.insert(seq.FrameUtime(i));
@@ -52,12 +56,24 @@ ConvertStats ConvertSequence(const Sequence& seq, const ConvertOptions& options,
       }
     };
     for (int i = first; i <= last; ++i) {
-      const VelodyneFrame frame = seq.ReadFrame(i);
-      const vtrack::ladar_scan_t scan = seq.Scan(i, frame);
-      write_poses_until(scan.utime);
-      log.WriteMessage(scan.utime, options.scan_channel, scan);
-      ++stats.scans;
-      stats.points += scan.npoints;
+      const VelodyneFrame frame = seq.has_scans() ? seq.ReadFrame(i) : VelodyneFrame{};
+      if (seq.has_scans()) {
+        const vtrack::ladar_scan_t scan = seq.Scan(i, frame);
+        write_poses_until(scan.utime);
+        log.WriteMessage(scan.utime, options.scan_channel, scan);
+        ++stats.scans;
+        stats.points += scan.npoints;
+      }
+      if (options.detections && seq.has_detections()) {
+        const vtrack::detection_list_t boxes = seq.Detections(i);
+        // With scans, right after the scan (its log time, so that the log stays in time order;
+        // the message holds the frame's time, half a sweep later); without, at the frame's time.
+        if (!seq.has_scans()) write_poses_until(boxes.utime);
+        log.WriteMessage(seq.has_scans() ? seq.ScanUtime(i) : boxes.utime,
+                         options.detections_channel, boxes);
+        ++stats.detection_lists;
+        stats.detections += boxes.num_detections;
+      }
       if (options.ground_truth && seq.has_labels()) {
         const vtrack::object_list_t truth = seq.GroundTruth(i, frame);
         log.WriteMessage(truth.utime, options.truth_channel, truth);

@@ -28,7 +28,11 @@ int main(int argc, char** argv) {
       "velodyne/NNNN/*.bin, label_02/NNNN.txt, calib/NNNN.txt, oxts/NNNN.txt) or a folder\n"
       "with velodyne_NNNN.tar.zst instead of velodyne/ (unpacked once into --cache-dir).\n"
       "Without --poses/--oxts the ego motion is DIR/oxts/NNNN.txt, else\n"
-      "DIR/ego_pose_estimated/poses_velo_icp.txt.\n\nOptions");
+      "DIR/ego_pose_estimated/poses_velo_icp.txt.\n"
+      "The boxes layout (no point clouds: label_02/, calib/, detections/pointrcnn_Car/NNNN.txt,\n"
+      "ego_pose_orbslam3/NNNN.txt camera-frame poses) gives EGO_POSE, GROUND_TRUTH and\n"
+      "DETECTIONS at each frame's time and no LADAR_SCAN. Where detections/pointrcnn_Car/NNNN.txt\n"
+      "exists, its boxes are written to DETECTIONS (in the body frame) unless --no-detections.\n\nOptions");
   desc.add_options()
       ("help,h", "print this help")
       ("kitti", po::value<std::string>(&seq_opt.dir)->required(), "KITTI directory")
@@ -45,6 +49,7 @@ int main(int argc, char** argv) {
       ("num-frames", po::value<int>(&conv.num_frames)->default_value(-1), "frames to convert (-1 = all)")
       ("pose-rate", po::value<double>(&pose_rate_hz)->default_value(100.0), "EGO_POSE rate [Hz], 10..1000")
       ("no-ground-truth", "do not write GROUND_TRUTH")
+      ("no-detections", "do not write DETECTIONS (the detector's boxes, where the folder has them)")
       ("image-width", po::value<int>(&seq_opt.image_width)->default_value(seq_opt.image_width),
        "camera 2 image width [px], for in_labelled_region")
       ("image-height", po::value<int>(&seq_opt.image_height)->default_value(seq_opt.image_height),
@@ -54,6 +59,7 @@ int main(int argc, char** argv) {
       ("scan-channel", po::value<std::string>(&conv.scan_channel)->default_value(conv.scan_channel), "")
       ("pose-channel", po::value<std::string>(&conv.pose_channel)->default_value(conv.pose_channel), "")
       ("truth-channel", po::value<std::string>(&conv.truth_channel)->default_value(conv.truth_channel), "")
+      ("detections-channel", po::value<std::string>(&conv.detections_channel)->default_value(conv.detections_channel), "")
       ("quiet,q", po::bool_switch(&quiet), "no progress output");
 
   po::variables_map vm;
@@ -74,6 +80,7 @@ int main(int argc, char** argv) {
   }
   conv.pose_period_us = static_cast<std::int64_t>(1e6 / pose_rate_hz + 0.5);
   conv.ground_truth = vm.count("no-ground-truth") == 0;
+  conv.detections = vm.count("no-detections") == 0;
   if (const std::string err = conv.Validate(); !err.empty()) {
     std::cerr << "vtrack-kitti2lcm: bad option: " << err << "\n";
     return 2;
@@ -94,8 +101,12 @@ int main(int argc, char** argv) {
     const vtrack::kitti::Sequence seq(seq_opt);
     if (!quiet) {
       std::cerr << "vtrack-kitti2lcm: sequence " << seq.sequence() << ": " << seq.num_frames()
-                << " frames from " << seq.paths().velodyne_dir << ", ego motion from "
-                << (seq.paths().poses_file.empty() ? seq.paths().oxts_file : seq.paths().poses_file)
+                << " frames from "
+                << (seq.has_scans() ? seq.paths().velodyne_dir : std::string("(no point clouds)"))
+                << ", ego motion from "
+                << (!seq.paths().camera_poses_file.empty() ? seq.paths().camera_poses_file
+                    : seq.paths().poses_file.empty()       ? seq.paths().oxts_file
+                                                           : seq.paths().poses_file)
                 << (seq.has_labels() ? ", labels from " + seq.paths().label_file : ", no labels")
                 << std::endl;
     }
@@ -115,10 +126,12 @@ int main(int argc, char** argv) {
     const auto stats = vtrack::kitti::ConvertSequence(seq, conv, progress);
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf("vtrack-kitti2lcm: wrote %s: %d frames, %lld scans (%lld points), %lld poses, "
-                "%lld ground-truth lists (%lld objects), %.1f MB in %.1f s\n",
+                "%lld ground-truth lists (%lld objects), %lld detection lists (%lld boxes), "
+                "%.1f MB in %.1f s\n",
                 conv.out.c_str(), stats.frames, static_cast<long long>(stats.scans),
                 static_cast<long long>(stats.points), static_cast<long long>(stats.poses),
                 static_cast<long long>(stats.truth_lists), static_cast<long long>(stats.truth_objects),
+                static_cast<long long>(stats.detection_lists), static_cast<long long>(stats.detections),
                 stats.bytes / 1e6, secs);
   } catch (const std::exception& e) {
     std::cerr << "vtrack-kitti2lcm: error: " << e.what() << "\n";

@@ -1,5 +1,6 @@
 #include "sensor_driver/kitti/kitti_io.h"
 
+#include <algorithm>
 #include <bit>
 #include <cctype>
 #include <cerrno>
@@ -280,6 +281,43 @@ std::vector<Label> ReadLabels(const std::string& path) {
     labels.push_back(std::move(l));
   }
   return labels;
+}
+
+std::vector<DetectionRow> ReadDetections(const std::string& path) {
+  std::ifstream in = OpenText(path, "detections");
+  std::vector<DetectionRow> rows;
+  std::string text;
+  int line = 0;
+  while (std::getline(in, text)) {
+    ++line;
+    if (IsBlank(text)) continue;
+    std::replace(text.begin(), text.end(), ',', ' ');
+    const auto tok = Split(text);
+    if (tok.size() != 15) {
+      Fail(path, line, "expected 15 comma-separated fields (frame,type,x1,y1,x2,y2,score,h,w,l,x,y,z,"
+                       "rot_y,alpha), got " + std::to_string(tok.size()));
+    }
+    DetectionRow d;
+    d.line = line;
+    d.frame = ParseInt(tok[0], path, line, "frame");
+    d.type = ParseInt(tok[1], path, line, "type");
+    d.score = ParseDouble(tok[6], path, line, "score");
+    d.height = ParseDouble(tok[7], path, line, "h");
+    d.width = ParseDouble(tok[8], path, line, "w");
+    d.length = ParseDouble(tok[9], path, line, "l");
+    for (int k = 0; k < 3; ++k) {
+      d.bottom_center_rect[k] = ParseDouble(tok[10 + static_cast<std::size_t>(k)], path, line, "location");
+    }
+    d.rotation_y = ParseDouble(tok[13], path, line, "rot_y");
+    if (d.frame < 0) Fail(path, line, "negative frame " + std::to_string(d.frame));
+    if (!(d.height > 0.0 && d.width > 0.0 && d.length > 0.0)) {
+      std::ostringstream os;
+      os << "non-positive dimensions h w l = " << d.height << " " << d.width << " " << d.length;
+      Fail(path, line, os.str());
+    }
+    rows.push_back(d);
+  }
+  return rows;
 }
 
 std::vector<Eigen::Isometry3d> ReadPoses(const std::string& path) {

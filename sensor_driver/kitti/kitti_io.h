@@ -80,6 +80,23 @@ struct Label {
 // type, positive dimensions (except DontCare), frame >= 0, track_id >= 0 (-1 only for DontCare).
 std::vector<Label> ReadLabels(const std::string& path);
 
+// One row of a detections file (detections/pointrcnn_Car/NNNN.txt, as distributed with the
+// AB3DMOT baseline), comma separated: frame,type,x1,y1,x2,y2,score,h,w,l,x,y,z,rot_y,alpha; the
+// box in the same rect frame and convention as the labels (type 2 = Car).
+struct DetectionRow {
+  int frame = 0;            // [-]
+  int type = 0;             // [-] 1 Pedestrian, 2 Car, 3 Cyclist (AB3DMOT's numbering)
+  double score = 0.0;       // [-] the detector's confidence (PointRCNN: a logit, may be < 0)
+  double height = 0.0, width = 0.0, length = 0.0;  // [m] h w l
+  Eigen::Vector3d bottom_center_rect = Eigen::Vector3d::Zero();  // [m] rect frame
+  double rotation_y = 0.0;  // [rad]
+  int line = 0;             // [-]
+};
+
+// Reads a detections file; every row checked (15 fields, finite numbers, frame >= 0, positive
+// dimensions), a malformed one refused naming the file and line.
+std::vector<DetectionRow> ReadDetections(const std::string& path);
+
 // Object class of a label type as object_t::CLASS_*; throws KittiError for an unknown type.
 std::int8_t ClassOfType(const std::string& type);
 

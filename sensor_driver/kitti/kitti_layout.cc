@@ -230,7 +230,8 @@ SequencePaths LocateSequence(const std::string& dir, const std::string& sequence
   }
   fs::path root(dir);
   auto has_sequence = [&](const fs::path& r) {
-    return fs::is_directory(r / "velodyne" / seq) || Exists(r / ("velodyne_" + seq + ".tar.zst"));
+    return fs::is_directory(r / "velodyne" / seq) || Exists(r / ("velodyne_" + seq + ".tar.zst")) ||
+           Exists(r / "ego_pose_orbslam3" / (seq + ".txt"));
   };
   if (!has_sequence(root) && has_sequence(root / "training")) root = root / "training";
   SequencePaths p;
@@ -241,6 +242,8 @@ SequencePaths LocateSequence(const std::string& dir, const std::string& sequence
   } else if (Exists(archive)) {
     p.packed = true;
     p.velodyne_dir = UnpackVelodyneArchive(archive.string(), seq, cache_dir, sink);
+  } else if (Exists(root / "ego_pose_orbslam3" / (seq + ".txt"))) {
+    // The boxes layout: no point clouds.
   } else {
     throw KittiError("sequence " + seq + " not found in " + dir + ": no " +
                      (root / "velodyne" / seq).string() + "/ and no " + archive.string() +
@@ -252,6 +255,8 @@ SequencePaths LocateSequence(const std::string& dir, const std::string& sequence
   }
   const fs::path labels = root / "label_02" / (seq + ".txt");
   if (fs::is_regular_file(labels)) p.label_file = labels.string();
+  const fs::path detections = root / "detections" / "pointrcnn_Car" / (seq + ".txt");
+  if (fs::is_regular_file(detections)) p.detections_file = detections.string();
 
   if (!poses_file.empty()) {
     if (!fs::is_regular_file(poses_file)) throw KittiError("poses file " + poses_file + " does not exist");
@@ -262,7 +267,10 @@ SequencePaths LocateSequence(const std::string& dir, const std::string& sequence
   } else {
     const fs::path oxts = root / "oxts" / (seq + ".txt");
     const fs::path icp = root / "ego_pose_estimated" / "poses_velo_icp.txt";
-    if (fs::is_regular_file(oxts)) {
+    const fs::path orbslam = root / "ego_pose_orbslam3" / (seq + ".txt");
+    if (p.velodyne_dir.empty()) {
+      p.camera_poses_file = orbslam.string();
+    } else if (fs::is_regular_file(oxts)) {
       p.oxts_file = oxts.string();
     } else if (fs::is_regular_file(icp)) {
       p.poses_file = icp.string();

@@ -3,6 +3,8 @@
 //  standard (the KITTI tracking download; DIR may be the folder holding training/ or training/):
 //    DIR/velodyne/NNNN/000000.bin ...   DIR/label_02/NNNN.txt   DIR/calib/NNNN.txt
 //    DIR/oxts/NNNN.txt
+//  boxes (../shared/data/kitti_tracking_boxes): no point clouds; label_02/, calib/,
+//    detections/pointrcnn_Car/NNNN.txt and ego_pose_orbslam3/NNNN.txt (camera-frame poses).
 //  packed (../shared/data/kitti_tracking_0000): as above, but the point clouds are one archive
 //    DIR/velodyne_NNNN.tar.zst (+ .sha256), unpacked once into a cache directory, and the ego
 //    motion is DIR/ego_pose_estimated/poses_velo_icp.txt (KITTI odometry poses layout).
@@ -24,11 +26,14 @@ using MessageSink = std::function<void(const std::string&)>;
 
 struct SequencePaths {
   std::string root;           // the folder holding velodyne/ (or the archive), label_02/, calib/
-  std::string velodyne_dir;   // folder of 000000.bin ... (after unpacking, if packed)
+  std::string velodyne_dir;   // folder of 000000.bin ... (after unpacking, if packed); "" in
+                              //     the boxes layout
   std::string calib_file;
   std::string label_file;     // "" if the sequence has no labels (test split)
-  std::string poses_file;     // KITTI odometry layout poses (exactly one of poses/oxts is set)
-  std::string oxts_file;
+  std::string poses_file;     // KITTI odometry layout poses (exactly one of poses/oxts/camera
+  std::string oxts_file;      //     poses is set)
+  std::string camera_poses_file;  // boxes layout: rect frame i -> rect frame 0 (odometry layout)
+  std::string detections_file;    // detections/pointrcnn_Car/NNNN.txt; "" if absent
   bool packed = false;        // velodyne came from an archive
 };
 

@@ -90,9 +90,28 @@ Sequence::Sequence(SequenceOptions options) : options_(std::move(options)) {
   paths_ = LocateSequence(options_.dir, sequence_, options_.poses_file, options_.oxts_file,
                           options_.cache_dir, options_.sink);
   calib_ = ReadCalibration(paths_.calib_file);
-  num_frames_ = CountFrames(paths_.velodyne_dir);
+  if (!paths_.camera_poses_file.empty()) {
+    // Boxes layout: the frames are the camera poses' lines; velo0_from_velo_i =
+    // velo_from_rect * rect0_from_rect_i * rect_from_velo.
+    const std::vector<Eigen::Isometry3d> cam = ReadPoses(paths_.camera_poses_file);
+    const Eigen::Affine3d rect_from_velo = calib_.RectFromVelo(), velo_from_rect = calib_.VeloFromRect();
+    for (const Eigen::Isometry3d& c : cam) {
+      const Eigen::Affine3d v = velo_from_rect * c * rect_from_velo;
+      Eigen::Isometry3d iso = Eigen::Isometry3d::Identity();
+      // Re-orthonormalised: the calibration's blocks are orthonormal only to ~1e-6.
+      iso.linear() = Eigen::Quaterniond(v.linear()).normalized().toRotationMatrix();
+      iso.translation() = v.translation();
+      world_from_body_.push_back(iso);
+    }
+    num_frames_ = static_cast<int>(world_from_body_.size());
+    if (num_frames_ == 0) throw KittiError("poses file " + paths_.camera_poses_file + " has no pose");
+  } else {
+    num_frames_ = CountFrames(paths_.velodyne_dir);
+  }
 
-  if (!paths_.poses_file.empty()) {
+  if (!paths_.camera_poses_file.empty()) {
+    // read above
+  } else if (!paths_.poses_file.empty()) {
     world_from_body_ = ReadPoses(paths_.poses_file);
     if (static_cast<int>(world_from_body_.size()) < num_frames_) {
       throw KittiError("poses file " + paths_.poses_file + " has " + std::to_string(world_from_body_.size()) +
@@ -115,6 +134,17 @@ Sequence::Sequence(SequenceOptions options) : options_(std::move(options)) {
   }
   world_from_body_.resize(static_cast<std::size_t>(num_frames_));
   BuildPoseRates();
+  detections_.assign(static_cast<std::size_t>(num_frames_), {});
+  if (has_detections()) {
+    for (const DetectionRow& d : ReadDetections(paths_.detections_file)) {
+      if (d.frame >= num_frames_) {
+        throw KittiError(paths_.detections_file + ":" + std::to_string(d.line) + ": detection for frame " +
+                         std::to_string(d.frame) + " but the sequence has " + std::to_string(num_frames_) +
+                         " frames");
+      }
+      detections_[static_cast<std::size_t>(d.frame)].push_back(d);
+    }
+  }
   if (has_labels()) {
     labels_ = ReadLabels(paths_.label_file);
     BuildGroundTruth();
@@ -336,9 +366,40 @@ void Sequence::BuildGroundTruth() {
   }
 }
 
+vtrack::detection_list_t Sequence::Detections(int i) const {
+  CheckFrame(i);
+  vtrack::detection_list_t list;
+  list.utime = FrameUtime(i);
+  list.seq = i;
+  list.source = "pointrcnn";
+  const Eigen::Affine3d velo_from_rect = calib_.VeloFromRect();
+  for (const DetectionRow& d : detections_[static_cast<std::size_t>(i)]) {
+    // As the labels: the length axis R_y(rot_y) * x = (cos ry, 0, -sin ry) in rect.
+    const Eigen::Vector3d bottom = velo_from_rect * d.bottom_center_rect;
+    const Eigen::Vector3d axis =
+        velo_from_rect.linear() * Eigen::Vector3d(std::cos(d.rotation_y), 0.0, -std::sin(d.rotation_y));
+    vtrack::detection_t o;
+    o.object_class = d.type == 2 ? vtrack::object_t::CLASS_CAR
+                     : d.type == 1 ? vtrack::object_t::CLASS_PEDESTRIAN
+                     : d.type == 3 ? vtrack::object_t::CLASS_CYCLIST
+                                   : vtrack::object_t::CLASS_UNKNOWN;
+    o.score = static_cast<float>(d.score);
+    o.x = bottom.x();
+    o.y = bottom.y();
+    o.z = bottom.z();
+    o.yaw = WrapToPi(std::atan2(axis.y(), axis.x()));
+    o.length = d.length;
+    o.width = d.width;
+    o.height = d.height;
+    list.detections.push_back(o);
+  }
+  list.num_detections = static_cast<std::int32_t>(list.detections.size());
+  return list;
+}
+
 vtrack::object_list_t Sequence::GroundTruth(int i) const {
   CheckFrame(i);
-  if (!has_labels() || objects_[static_cast<std::size_t>(i)].empty()) {
+  if (!has_labels() || objects_[static_cast<std::size_t>(i)].empty() || !has_scans()) {
     return GroundTruth(i, VelodyneFrame{});
   }
   return GroundTruth(i, ReadFrame(i));
@@ -347,7 +408,7 @@ vtrack::object_list_t Sequence::GroundTruth(int i) const {
 vtrack::object_list_t Sequence::GroundTruth(int i, const VelodyneFrame& frame) const {
   CheckFrame(i);
   vtrack::object_list_t list;
-  list.utime = ScanUtime(i);
+  list.utime = has_scans() ? ScanUtime(i) : FrameUtime(i);
   list.scan_seq = i;
   list.source = "kitti:" + sequence_;
   const auto& objs = objects_[static_cast<std::size_t>(i)];
@@ -393,7 +454,7 @@ vtrack::object_list_t Sequence::GroundTruth(int i, const VelodyneFrame& frame) c
   }
   for (std::size_t k = 0; k < objs.size(); ++k) {
     vtrack::object_t o = objs[k].object;
-    o.num_points = boxes[k].count;
+    o.num_points = has_scans() ? boxes[k].count : -1;  // no point clouds: unknown
     list.objects.push_back(o);
   }
   return list;

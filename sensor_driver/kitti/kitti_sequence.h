@@ -21,6 +21,7 @@
 #include "sensor_driver/kitti/kitti_io.h"
 #include "sensor_driver/kitti/kitti_layout.h"
 #include "sensor_driver/kitti/kitti_scan.h"
+#include "vtrack/detection_list_t.hpp"
 #include "vtrack/ladar_scan_t.hpp"
 #include "vtrack/object_list_t.hpp"
 #include "vtrack/pose_t.hpp"
@@ -58,6 +59,13 @@ class Sequence {
   explicit Sequence(SequenceOptions options);
 
   int num_frames() const { return num_frames_; }
+  // False in the boxes layout (no point clouds): no scans; the ground truth is stamped with the
+  // frame's time, as the detections are.
+  bool has_scans() const { return !paths_.velodyne_dir.empty(); }
+  // The detector's boxes of frame i (detections/pointrcnn_Car) in the body (Velodyne) frame at
+  // FrameUtime(i), seq = i; empty list if the frame has none. has_detections(): the file exists.
+  bool has_detections() const { return !paths_.detections_file.empty(); }
+  vtrack::detection_list_t Detections(int i) const;
   const std::string& sequence() const { return sequence_; }
   const SequencePaths& paths() const { return paths_; }
   const Calibration& calibration() const { return calib_; }
@@ -117,6 +125,7 @@ class Sequence {
   int num_frames_ = 0;
   std::vector<Eigen::Isometry3d> world_from_body_;  // per frame
   std::vector<Eigen::Vector3d> vel_world_;           // [m/s] per frame
+  std::vector<std::vector<DetectionRow>> detections_;  // per frame
   std::vector<Eigen::Vector3d> rate_body_;           // [rad/s] per frame
   std::vector<Eigen::Vector3d> accel_body_;          // [m/s^2] per frame
   std::vector<Label> labels_;

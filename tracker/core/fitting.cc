@@ -704,187 +704,563 @@ void CheckRequest(const FitRequest& r) {
   throw std::invalid_argument(os.str());
 }
 
-// Turns a refined candidate into z, R and the geometry outputs (Eq. 17, 18). Returns the reason
-// if the candidate is rejected (inside fraction) or kNone.
-FitFailure Measure(const Context& ctx, const FitRequest& req, const FitParams& params,
-                   const Candidate& cand, FitResult* out) {
+// The rectangle a candidate places (Eq. 17): heading, centre and the dimensions used, with what
+// the fit says of the seen extents in *out, and the parts of R that come from the shape.
+struct CentreGeometry {
+  double theta = 0.0;
+  Eigen::Vector2d center = Eigen::Vector2d::Zero();     // local
+  Eigen::Vector2d along_t = Eigen::Vector2d::Zero();    // single edge: the face's direction
+  Eigen::Vector2d along_mid = Eigen::Vector2d::Zero();  // single edge: middle of the seen part
+  double along_var = 0.0;                  // single edge: prior variance along the face
+  Eigen::Matrix2d shape_cov = Eigen::Matrix2d::Zero();
+  double length_used = 0.0, width_used = 0.0;
+};
+
+// A corner: the heading from the prediction (Eq. 17) or the longer seen edge; the centre half the
+// dimensions in from the corner along both edges.
+CentreGeometry CornerGeometry(const FitRequest& req, const FitParams& params, const Candidate& cand,
+                              FitResult* out) {
   const Model& m = cand.model;
   const Eigen::Vector2d u0 = m.U0(), u1 = m.U1();
-  const bool corner = m.num_edges == 2;
   const double k_full = params.partial_view_sigmas;
-
-  double theta = 0.0;
-  Eigen::Vector2d center;                 // local
-  Eigen::Vector2d along_t = Eigen::Vector2d::Zero(), along_mid = Eigen::Vector2d::Zero();
-  double along_var = 0.0;                 // single edge: prior variance along the face
-  Eigen::Matrix2d shape_cov = Eigen::Matrix2d::Zero();
-  double length_used, width_used;
-
-  if (corner) {
-    const Extent& e0 = cand.ext[0];
-    const Extent& e1 = cand.ext[1];
-    // Extents from the corner to the far end, corrected outwards (EndOffsets).
-    const double E0 = e0.s_max + cand.hi[0].mean, E1 = e1.s_max + cand.hi[1].mean;
-    // Far end, and the corner's own position along the edge.
-    const Eigen::Matrix2d cov_c = m.cov.topLeftCorner<2, 2>();
-    const double var_E0 = cand.hi[0].var + u0.dot(cov_c * u0);
-    const double var_E1 = cand.hi[1].var + u1.dot(cov_c * u1);
-    if (req.predicted_theta) {
-      // Eq. (17): tau is the multiple of 90 deg bringing phi nearest the prediction (note 6).
-      const double tau = 0.5 * kPi * std::round(AngleDiff(*req.predicted_theta, m.phi) / (0.5 * kPi));
-      theta = WrapToPi(m.phi + tau);
-    } else {
-      theta = InRightHalfPlane(E0 >= E1 ? m.phi : m.phi + 0.5 * kPi);
-    }
-    // Edge 0's outward normal is -u1 (the body lies towards +u1), edge 1's is -u0.
-    out->edges[0].face = FaceFromNormal(AngleOf(-u1), theta);
-    out->edges[1].face = FaceFromNormal(AngleOf(-u0), theta);
-    const bool edge0_is_length = IsSideFace(out->edges[0].face);
-    const double E_len = edge0_is_length ? E0 : E1, E_wid = edge0_is_length ? E1 : E0;
-    const double var_len = edge0_is_length ? var_E0 : var_E1;
-    const double var_wid = edge0_is_length ? var_E1 : var_E0;
-    length_used = req.shape_known ? req.length_m : std::max(req.length_m, E_len);
-    width_used = req.shape_known ? req.width_m : std::max(req.width_m, E_wid);
-    const Eigen::Vector2d u_len = edge0_is_length ? u0 : u1, u_wid = edge0_is_length ? u1 : u0;
-    center = m.c + u_len * (0.5 * length_used) + u_wid * (0.5 * width_used);
-    out->observed_length_m = E_len;
-    out->observed_width_m = E_wid;
-    out->observed_length_std_m = std::sqrt(var_len);
-    out->observed_width_std_m = std::sqrt(var_wid);
-    out->length_full_view =
-        req.shape_known && req.length_m - E_len <= k_full * std::sqrt(var_len);
-    out->width_full_view = req.shape_known && req.width_m - E_wid <= k_full * std::sqrt(var_wid);
-    const Eigen::Vector2d axis = Dir(theta), lateral = Perp(axis);
-    shape_cov = 0.25 * req.length_std_m * req.length_std_m * axis * axis.transpose() +
-                0.25 * req.width_std_m * req.width_std_m * lateral * lateral.transpose();
+  CentreGeometry g;
+  const Extent& e0 = cand.ext[0];
+  const Extent& e1 = cand.ext[1];
+  // Extents from the corner to the far end, corrected outwards (EndOffsets).
+  const double E0 = e0.s_max + cand.hi[0].mean, E1 = e1.s_max + cand.hi[1].mean;
+  // Far end, and the corner's own position along the edge.
+  const Eigen::Matrix2d cov_c = m.cov.topLeftCorner<2, 2>();
+  const double var_E0 = cand.hi[0].var + u0.dot(cov_c * u0);
+  const double var_E1 = cand.hi[1].var + u1.dot(cov_c * u1);
+  if (req.predicted_theta) {
+    // Eq. (17): tau is the multiple of 90 deg bringing phi nearest the prediction (note 6).
+    const double tau = 0.5 * kPi * std::round(AngleDiff(*req.predicted_theta, m.phi) / (0.5 * kPi));
+    g.theta = WrapToPi(m.phi + tau);
   } else {
-    const Extent& e = cand.ext[0];
-    const double lo = e.s_min - cand.lo[0].mean, hi = e.s_max + cand.hi[0].mean;
-    along_mid = m.c + u0 * (0.5 * (lo + hi));
-    const double E = hi - lo;
-    Eigen::Vector2d n_out;
-    Face face;
-    EdgeHeading(ctx, req, params, m, E, &theta, &face, &n_out, along_mid);
-    out->edges[0].face = face;
-    const bool side = IsSideFace(face);
-    const double D_face = side ? req.length_m : req.width_m;
-    const double D_perp = side ? req.width_m : req.length_m;
-    const double std_face = side ? req.length_std_m : req.width_std_m;
-    const double std_perp = side ? req.width_std_m : req.length_std_m;
-    const double D_face_used = req.shape_known ? D_face : std::max(D_face, E);
-    length_used = side ? D_face_used : D_perp;
-    width_used = side ? D_perp : D_face_used;
-    const double var_E = cand.lo[0].var + cand.hi[0].var;
-    const bool full = req.shape_known && D_face - E <= k_full * std::sqrt(var_E);
-    if (!full && req.predicted_center) {
-      // Where along the face the seen part lies is not measured: the part's middle, taken anew
-      // on every scan of the same partial view (a car half hidden behind another), is the same
-      // error each time, and the filter would follow it (a parked car's track slid 2 m along
-      // its side at 1.4 m/s). The centre stays where predicted if the seen part (its ends
-      // corrected outwards) lies on the predicted face; else, the part's middle as before.
-      // Tried: moving the centre just far enough to hold the part if it sticks out by up to
-      // 0.25-1 m: urban laps went from 1 to 9 identity switches (a parked car whose corner fit
-      // takes the wrong axis got a second track), tracker/README.md. The variance along the face
-      // stays the paper's (below): the filter still grows too sure of the position along a face
-      // it sees only in part over many scans, as with the middle before; the mean is no longer
-      // pulled.
-      const double half = 0.5 * D_face_used;
-      const double s_pred = u0.dot(*req.predicted_center - ctx.origin - m.c);
-      if (s_pred >= hi - half && s_pred <= lo + half) along_mid = m.c + u0 * s_pred;
-    }
-    center = along_mid - n_out * (0.5 * D_perp);
-    along_var = var_E / 4.0;
-    if (!full) {
-      const double missing = std::max(D_face_used - E, 0.0);
-      along_var += 0.25 * (missing * missing + std_face * std_face);
-    }
-    along_t = u0;
-    (side ? out->observed_length_m : out->observed_width_m) = E;
-    (side ? out->observed_length_std_m : out->observed_width_std_m) = std::sqrt(var_E);
-    (side ? out->length_full_view : out->width_full_view) = full;
-    shape_cov = 0.25 * std_perp * std_perp * n_out * n_out.transpose();
+    g.theta = InRightHalfPlane(E0 >= E1 ? m.phi : m.phi + 0.5 * kPi);
   }
+  // Edge 0's outward normal is -u1 (the body lies towards +u1), edge 1's is -u0.
+  out->edges[0].face = FaceFromNormal(AngleOf(-u1), g.theta);
+  out->edges[1].face = FaceFromNormal(AngleOf(-u0), g.theta);
+  const bool edge0_is_length = IsSideFace(out->edges[0].face);
+  const double E_len = edge0_is_length ? E0 : E1, E_wid = edge0_is_length ? E1 : E0;
+  const double var_len = edge0_is_length ? var_E0 : var_E1;
+  const double var_wid = edge0_is_length ? var_E1 : var_E0;
+  g.length_used = req.shape_known ? req.length_m : std::max(req.length_m, E_len);
+  g.width_used = req.shape_known ? req.width_m : std::max(req.width_m, E_wid);
+  const Eigen::Vector2d u_len = edge0_is_length ? u0 : u1, u_wid = edge0_is_length ? u1 : u0;
+  g.center = m.c + u_len * (0.5 * g.length_used) + u_wid * (0.5 * g.width_used);
+  out->observed_length_m = E_len;
+  out->observed_width_m = E_wid;
+  out->observed_length_std_m = std::sqrt(var_len);
+  out->observed_width_std_m = std::sqrt(var_wid);
+  out->length_full_view = req.shape_known && req.length_m - E_len <= k_full * std::sqrt(var_len);
+  out->width_full_view = req.shape_known && req.width_m - E_wid <= k_full * std::sqrt(var_wid);
+  const Eigen::Vector2d axis = Dir(g.theta), lateral = Perp(axis);
+  g.shape_cov = 0.25 * req.length_std_m * req.length_std_m * axis * axis.transpose() +
+                0.25 * req.width_std_m * req.width_std_m * lateral * lateral.transpose();
+  return g;
+}
 
-  // Eq. (18) at the vehicle centre, weighted (see header): rows [-n_x, -n_y, n x (p - c)].
+// A single edge: which face it is (EdgeHeading), the centre half the other dimension behind it,
+// and along the face the seen part's middle (or, for a parked track, the prediction).
+CentreGeometry EdgeGeometry(const Context& ctx, const FitRequest& req, const FitParams& params,
+                            const Candidate& cand, FitResult* out) {
+  const Model& m = cand.model;
+  const Eigen::Vector2d u0 = m.U0();
+  const double k_full = params.partial_view_sigmas;
+  CentreGeometry g;
+  const Extent& e = cand.ext[0];
+  const double lo = e.s_min - cand.lo[0].mean, hi = e.s_max + cand.hi[0].mean;
+  g.along_mid = m.c + u0 * (0.5 * (lo + hi));
+  const double E = hi - lo;
+  Eigen::Vector2d n_out;
+  Face face;
+  EdgeHeading(ctx, req, params, m, E, &g.theta, &face, &n_out, g.along_mid);
+  out->edges[0].face = face;
+  const bool side = IsSideFace(face);
+  const double D_face = side ? req.length_m : req.width_m;
+  const double D_perp = side ? req.width_m : req.length_m;
+  const double std_face = side ? req.length_std_m : req.width_std_m;
+  const double std_perp = side ? req.width_std_m : req.length_std_m;
+  const double D_face_used = req.shape_known ? D_face : std::max(D_face, E);
+  g.length_used = side ? D_face_used : D_perp;
+  g.width_used = side ? D_perp : D_face_used;
+  const double var_E = cand.lo[0].var + cand.hi[0].var;
+  const bool full = req.shape_known && D_face - E <= k_full * std::sqrt(var_E);
+  if (!full && req.predicted_center) {
+    // Where along the face the seen part lies is not measured: the part's middle, taken anew on
+    // every scan of the same partial view (a car half hidden behind another), is the same error
+    // each time, and the filter would follow it (a parked car's track slid 2 m along its side at
+    // 1.4 m/s). The centre stays where predicted if the seen part (its ends corrected outwards)
+    // lies on the predicted face; else, the part's middle as before. (Moving the centre just far
+    // enough to hold a part that sticks out instead gave parked cars whose corner fit took the
+    // wrong axis a second track.) The variance along the face stays the paper's (below): the
+    // filter still grows too sure of the position along a face it sees only in part over many
+    // scans; the mean is no longer pulled.
+    const double half = 0.5 * D_face_used;
+    const double s_pred = u0.dot(*req.predicted_center - ctx.origin - m.c);
+    if (s_pred >= hi - half && s_pred <= lo + half) g.along_mid = m.c + u0 * s_pred;
+  }
+  g.center = g.along_mid - n_out * (0.5 * D_perp);
+  g.along_var = var_E / 4.0;
+  if (!full) {
+    const double missing = std::max(D_face_used - E, 0.0);
+    g.along_var += 0.25 * (missing * missing + std_face * std_face);
+  }
+  g.along_t = u0;
+  (side ? out->observed_length_m : out->observed_width_m) = E;
+  (side ? out->observed_length_std_m : out->observed_width_std_m) = std::sqrt(var_E);
+  (side ? out->length_full_view : out->width_full_view) = full;
+  g.shape_cov = 0.25 * std_perp * std_perp * n_out * n_out.transpose();
+  return g;
+}
+
+// Eq. (18) at the vehicle centre, weighted (see header): the information of the inliers' rows
+// [-n_x, -n_y, n x (p - c)], scaled down by the variance factor when the residuals say the
+// noise is larger than modelled.
+struct CentreInformation {
   Eigen::Matrix3d info = Eigen::Matrix3d::Zero();
-  double chi2 = 0.0, sum_r2 = 0.0;
+  double factor = 1.0, sum_r2 = 0.0;
   int count = 0, fitted = 0;  // inliers; those not ambiguous
+};
+CentreInformation InformationAtCentre(const Context& ctx, const FitParams& params, const Model& m,
+                                      const Eigen::Vector2d& center, const FitResult& out) {
+  const Eigen::Vector2d u0 = m.U0(), u1 = m.U1();
+  CentreInformation ci;
+  double chi2 = 0.0;
   for (int i = 0; i < ctx.n; ++i) {
-    const int k = out->point_edge[i];
+    const int k = out.point_edge[i];
     if (k < 0) continue;
-    ++count;
+    ++ci.count;
     if (k >= kAmbiguous) continue;
     const Eigen::Vector2d p = ctx.P(i);
     const Eigen::Vector2d& normal = (k == 0) ? u1 : u0;
     const double r = normal.dot(p - m.c);
     const double w = 1.0 / ctx.PerpVar(normal.dot(ctx.RayAt(i)));
     const Eigen::Vector3d J(-normal.x(), -normal.y(), Cross(normal, p - center));
-    info.noalias() += w * J * J.transpose();
+    ci.info.noalias() += w * J * J.transpose();
     chi2 += w * r * r;
-    sum_r2 += r * r;
-    ++fitted;
+    ci.sum_r2 += r * r;
+    ++ci.fitted;
   }
-  const int dof = fitted - (corner ? 3 : 2);
-  double factor = 1.0;
+  const int dof = ci.fitted - (m.num_edges == 2 ? 3 : 2);
   if (params.variance_factor_sigmas > 0.0 && dof > 0) {
     const double ratio = chi2 / dof;
-    if (ratio > 1.0 + params.variance_factor_sigmas * std::sqrt(2.0 / dof)) factor = ratio;
+    if (ratio > 1.0 + params.variance_factor_sigmas * std::sqrt(2.0 / dof)) ci.factor = ratio;
   }
-  info /= factor;
+  ci.info /= ci.factor;
+  return ci;
+}
+
+// R = the inverse information, with the single edge's position along the face and its second
+// order term, and the shape's part. False if the information is singular.
+bool CovarianceAtCentre(const CentreGeometry& g, bool corner, Eigen::Matrix3d info,
+                        Eigen::Matrix3d* R_out) {
   if (!corner) {
     // The position along the face: residual t . (c - m) about the extent's middle m.
-    const Eigen::Vector3d e(along_t.x(), along_t.y(), Perp(along_t).dot(center - along_mid));
-    info.noalias() += e * e.transpose() / along_var;
+    const Eigen::Vector3d e(g.along_t.x(), g.along_t.y(), Perp(g.along_t).dot(g.center - g.along_mid));
+    info.noalias() += e * e.transpose() / g.along_var;
   }
   const Eigen::LDLT<Eigen::Matrix3d> ldlt(info);
   if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 1e-12 * info.trace())) {
-    return FitFailure::kNoConsensus;  // cannot happen with >= min_edge_inliers spread points
+    return false;  // cannot happen with >= min_edge_inliers spread points
   }
   Eigen::Matrix3d R = ldlt.solve(Eigen::Matrix3d::Identity());
   if (!corner) {
-    // Second order: the face line is known about the seen part; a heading error d_theta moves
-    // it by (s - s_hat) d_theta at the centre's true position s along the face, a product of
-    // two independent errors with variance var_along * var_theta. It matters when part of the
-    // face is hidden (var_along large): the linear R above cannot contain it.
-    const double var_along = along_t.dot(R.topLeftCorner<2, 2>() * along_t);
-    const Eigen::Vector2d normal = Perp(along_t);
+    // Second order: the face line is known about the seen part; a heading error d_theta moves it
+    // by (s - s_hat) d_theta at the centre's true position s along the face, a product of two
+    // independent errors with variance var_along * var_theta. It matters when part of the face
+    // is hidden (var_along large): the linear R above cannot contain it.
+    const double var_along = g.along_t.dot(R.topLeftCorner<2, 2>() * g.along_t);
+    const Eigen::Vector2d normal = Perp(g.along_t);
     R.topLeftCorner<2, 2>() += var_along * R(2, 2) * normal * normal.transpose();
   }
-  R.topLeftCorner<2, 2>() += shape_cov;
-  R = 0.5 * (R + R.transpose()).eval();
+  R.topLeftCorner<2, 2>() += g.shape_cov;
+  *R_out = 0.5 * (R + R.transpose()).eval();
+  return true;
+}
 
-  // Required share of the segment inside the rectangle (the hypothesis' constraint).
-  OrientedBox box{center, theta, length_used, width_used};
-  int inside = 0;
-  for (int i = 0; i < ctx.n; ++i) inside += box.Contains(ctx.P(i), params.inside_margin_m) ? 1 : 0;
-  out->inside_fraction = static_cast<double>(inside) / ctx.n;
-  if (out->inside_fraction < req.min_inside_fraction) return FitFailure::kTooFewPointsInside;
-
+// The fit's outputs: kind, edges, z, R and the points' labels.
+void FillResult(const Context& ctx, const Candidate& cand, const CentreGeometry& g,
+                const CentreInformation& ci, const Eigen::Matrix3d& R, FitResult* out) {
+  const Model& m = cand.model;
+  const bool corner = m.num_edges == 2;
   out->kind = corner ? FitKind::kCorner : FitKind::kEdge;
   out->num_edges = m.num_edges;
   out->phi = WrapToPi(m.phi);
   out->corner = corner ? Eigen::Vector2d(m.c + ctx.origin) : Eigen::Vector2d::Constant(kNaN);
   for (int k = 0; k < m.num_edges; ++k) {
-    const Eigen::Vector2d u = k == 0 ? u0 : u1;
+    const Eigen::Vector2d u = k == 0 ? m.U0() : m.U1();
     const Extent& e = cand.ext[k];
     out->edges[k].start = ctx.origin + m.c + u * (corner ? 0.0 : e.s_min);
     out->edges[k].end = ctx.origin + m.c + u * e.s_max;
     out->edges[k].num_inliers = cand.counts[k];
   }
-  out->z << center + ctx.origin, theta;
+  out->z << g.center + ctx.origin, g.theta;
   out->R = R;
-  out->length_used_m = length_used;
-  out->width_used_m = width_used;
-  out->num_inliers = count;
-  out->variance_factor = factor;
-  out->rms_residual_m = std::sqrt(sum_r2 / std::max(fitted, 1));
+  out->length_used_m = g.length_used;
+  out->width_used_m = g.width_used;
+  out->num_inliers = ci.count;
+  out->variance_factor = ci.factor;
+  out->rms_residual_m = std::sqrt(ci.sum_r2 / std::max(ci.fitted, 1));
   out->point_in_fit.resize(ctx.n);
   for (int i = 0; i < ctx.n; ++i) {
     std::int8_t& label = out->point_edge[i];
     out->point_in_fit[i] = label >= 0 && label < kAmbiguous;
     label = static_cast<std::int8_t>(EdgeOf(label));
   }
+}
+
+// Turns a refined candidate into z, R and the geometry outputs (Eq. 17, 18). Returns the reason
+// if the candidate is rejected (inside fraction) or kNone.
+FitFailure Measure(const Context& ctx, const FitRequest& req, const FitParams& params,
+                   const Candidate& cand, FitResult* out) {
+  const bool corner = cand.model.num_edges == 2;
+  const CentreGeometry g = corner ? CornerGeometry(req, params, cand, out)
+                                  : EdgeGeometry(ctx, req, params, cand, out);
+  const CentreInformation ci = InformationAtCentre(ctx, params, cand.model, g.center, *out);
+  Eigen::Matrix3d R;
+  if (!CovarianceAtCentre(g, corner, ci.info, &R)) return FitFailure::kNoConsensus;
+  // Required share of the segment inside the rectangle (the hypothesis' constraint).
+  OrientedBox box{g.center, g.theta, g.length_used, g.width_used};
+  int inside = 0;
+  for (int i = 0; i < ctx.n; ++i) inside += box.Contains(ctx.P(i), params.inside_margin_m) ? 1 : 0;
+  out->inside_fraction = static_cast<double>(inside) / ctx.n;
+  if (out->inside_fraction < req.min_inside_fraction) return FitFailure::kTooFewPointsInside;
+  FillResult(ctx, cand, g, ci, R, out);
   return FitFailure::kNone;
+}
+
+// The scoring subset of RANSAC: one point drawn from each of S equal strata of the point order
+// (local coordinates and ray directions).
+struct Subset {
+  const double *x, *y, *rx, *ry;
+  int size;
+  Eigen::Vector2d P(int i) const { return {x[i], y[i]}; }
+};
+
+Subset DrawSubset(const Context& ctx, int max_points, std::minstd_rand& rng, std::vector<double>* sx,
+                  std::vector<double>* sy, std::vector<double>* srx, std::vector<double>* sry) {
+  const int n = ctx.n;
+  const int S = std::min(n, max_points);
+  sx->resize(S);
+  sy->resize(S);
+  srx->resize(S);
+  sry->resize(S);
+  for (int i = 0; i < S; ++i) {
+    const int lo = static_cast<int>(static_cast<std::int64_t>(i) * n / S);
+    const int hi = static_cast<int>(static_cast<std::int64_t>(i + 1) * n / S) - 1;
+    const int idx = hi > lo ? std::uniform_int_distribution<int>(lo, hi)(rng) : lo;
+    const Eigen::Vector2d p = ctx.P(idx);
+    const Eigen::Vector2d ray = ctx.RayAt(idx);
+    (*sx)[i] = p.x();
+    (*sy)[i] = p.y();
+    (*srx)[i] = ray.x();
+    (*sry)[i] = ray.y();
+  }
+  return {sx->data(), sy->data(), srx->data(), sry->data(), S};
+}
+
+// RANSAC for a straight edge (2 points): the truncated quadratic cost of Eq. (16) over the
+// subset; samples whose edge the sensor cannot see (Eq. 15) are skipped.
+Model RansacEdge(const Context& ctx, const Subset& sub, const FitParams& P, double slant,
+                 std::uniform_int_distribution<int>& pick, std::minstd_rand& rng) {
+  const int S = sub.size;
+  const double min_sep2 = P.min_sample_separation_m * P.min_sample_separation_m;
+  Model best;
+  double best_cost = std::numeric_limits<double>::infinity();
+  int needed = P.max_edge_iterations;
+  for (int it = 0; it < P.max_edge_iterations; ++it) {
+    if (it >= needed && it >= P.min_iterations) break;
+    const int i = pick(rng), j = pick(rng);
+    if (i == j) continue;
+    const Eigen::Vector2d pi = sub.P(i), pj = sub.P(j);
+    const Eigen::Vector2d d = pj - pi;
+    if (d.squaredNorm() < std::max(min_sep2, 1e-18)) continue;
+    const Eigen::Vector2d u = d.normalized();
+    const Eigen::Vector2d mid = 0.5 * (pi + pj);
+    if (!EdgeVisible(mid, u, ctx.sensor, slant)) continue;
+    const Eigen::Vector2d nrm = Perp(u);
+    double cost = 0.0;
+    int inliers = 0;
+    for (int s = 0; s < S; ++s) {
+      const double r = nrm.x() * (sub.x[s] - mid.x()) + nrm.y() * (sub.y[s] - mid.y());
+      const double ca = nrm.x() * sub.rx[s] + nrm.y() * sub.ry[s];
+      const double e = r * r / ctx.Threshold2(ctx.PerpVar(ca));
+      if (e < 1.0) {
+        cost += e;
+        ++inliers;
+      } else {
+        cost += 1.0;
+      }
+    }
+    if (cost < best_cost) {
+      best_cost = cost;
+      best.num_edges = 1;
+      best.c = mid;
+      best.phi = AngleOf(u);
+      const double w = static_cast<double>(inliers) / S;
+      needed = IterationsFor(w * w, P.ransac_confidence);
+    }
+  }
+  return best;
+}
+
+// The truncated cost of a corner over the subset, with the inliers of each edge.
+double CornerCost(const Context& ctx, const Subset& sub, const Eigen::Vector2d& corner,
+                  const Eigen::Vector2d& u0, const Eigen::Vector2d& u1, int* n0, int* n1) {
+  double cost = 0.0;
+  *n0 = *n1 = 0;
+  for (int s = 0; s < sub.size; ++s) {
+    const double vx = sub.x[s] - corner.x(), vy = sub.y[s] - corner.y();
+    const double a0 = u0.x() * vx + u0.y() * vy;  // along edge 0 = residual of edge 1
+    const double a1 = u1.x() * vx + u1.y() * vy;  // along edge 1 = residual of edge 0
+    const double t0 = ctx.Threshold2(ctx.PerpVar(u1.x() * sub.rx[s] + u1.y() * sub.ry[s]));
+    const double t1 = ctx.Threshold2(ctx.PerpVar(u0.x() * sub.rx[s] + u0.y() * sub.ry[s]));
+    const double e0 = (a0 >= 0.0 || a0 * a0 < t0) ? a1 * a1 / t0 : 1.0;
+    const double e1 = (a1 >= 0.0 || a1 * a1 < t1) ? a0 * a0 / t1 : 1.0;
+    if (e0 < 1.0 && e0 <= e1) {
+      cost += e0;
+      ++*n0;
+    } else if (e1 < 1.0) {
+      cost += e1;
+      ++*n1;
+    } else {
+      cost += 1.0;
+    }
+  }
+  return cost;
+}
+
+// RANSAC for a corner (3 points, the three corners of Figure 3 each, filtered by Eq. 15).
+Model RansacCorner(const Context& ctx, const Subset& sub, const FitParams& P, double slant,
+                   std::uniform_int_distribution<int>& pick, std::minstd_rand& rng) {
+  const int S = sub.size;
+  const double min_sep2 = P.min_sample_separation_m * P.min_sample_separation_m;
+  Model best;
+  double best_cost = std::numeric_limits<double>::infinity();
+  int needed = P.max_corner_iterations;
+  for (int it = 0; it < P.max_corner_iterations && S >= 3; ++it) {
+    if (it >= needed && it >= P.min_iterations) break;
+    const int idx[3] = {pick(rng), pick(rng), pick(rng)};
+    if (idx[0] == idx[1] || idx[1] == idx[2] || idx[0] == idx[2]) continue;
+    const Eigen::Vector2d q[3] = {sub.P(idx[0]), sub.P(idx[1]), sub.P(idx[2])};
+    const auto hyps = CornerHypothesesFromPoints(q[0], q[1], q[2]);
+    for (int k = 0; k < 3; ++k) {
+      const CornerHypothesis& h = hyps[k];
+      if (h.degenerate || h.a_both_ways) continue;
+      if ((q[(k + 1) % 3] - q[(k + 2) % 3]).squaredNorm() < min_sep2) continue;
+      if ((q[k] - h.corner).squaredNorm() < min_sep2) continue;
+      if (!CornerVisible(h, ctx.sensor, slant)) continue;
+      const Eigen::Vector2d u0 = Cross(h.dir_a, h.dir_b) > 0.0 ? h.dir_a : h.dir_b;
+      const Eigen::Vector2d u1 = Perp(u0);
+      int n0 = 0, n1 = 0;
+      const double cost = CornerCost(ctx, sub, h.corner, u0, u1, &n0, &n1);
+      if (cost < best_cost) {
+        best_cost = cost;
+        best.num_edges = 2;
+        best.c = h.corner;
+        best.phi = AngleOf(u0);
+        const double wa = static_cast<double>(n0) / S, wb = static_cast<double>(n1) / S;
+        // A triple is a good sample if it holds points of both edges and no outlier.
+        needed = IterationsFor(3.0 * wa * wb * (wa + wb), P.ransac_confidence);
+      }
+    }
+  }
+  return best;
+}
+
+// Refinement of RANSAC's models on all points, and the measurement of the chosen one.
+class Refiner {
+ public:
+  Refiner(const Context& ctx, const FitRequest& req, const FitParams& P, FitResult* out,
+          std::vector<double>* proj, std::vector<double>* gaps)
+      : ctx_(ctx), req_(req), P_(P), out_(out), labels_(out->point_edge.data()), proj_(proj),
+        gaps_(gaps) {}
+
+  // Single edge: points marked ambiguous or excluded (nullptr: none).
+  void set_mask(const std::int8_t* mask) { mask_ = mask; }
+  const std::int8_t* mask() const { return mask_; }
+  std::int8_t* labels() const { return labels_; }
+  FitFailure failure() const { return failure_; }
+  void set_failure(FitFailure f) { failure_ = f; }
+
+  // Inliers of the candidate's model into the labels, their runs and extents; a checksum of
+  // the classification.
+  std::uint64_t Classify(Candidate* cand) {
+    std::uint64_t checksum = vtrack::Classify(ctx_, cand->model, mask_, labels_, cand->counts);
+    for (int k = 0; k < cand->model.num_edges; ++k) {
+      cand->ext[k] = GapFilter(ctx_, cand->model, k, P_.max_inlier_gap_m, P_.max_gap_spacings,
+                               labels_, proj_, gaps_);
+      cand->counts[k] = cand->ext[k].n;
+      checksum = checksum * 31 + static_cast<std::uint64_t>(cand->ext[k].n);
+    }
+    return checksum;
+  }
+
+  // Eq. (16) from a RANSAC sample: the inlier set changes as the model improves, so steps and
+  // classification alternate until the step is negligible and the inliers stay the same (the
+  // model is then the minimum of Eq. 16 over exactly the inliers reported and used for R). The
+  // inlier set can oscillate between two models (a point at the threshold): then it finishes on
+  // the last classification held fixed.
+  void Refine(const Model& start, Candidate* cand) {
+    cand->model = start;
+    std::uint64_t checksum = Classify(cand);
+    bool converged = false;
+    for (int it = 0; it < P_.gauss_newton_iterations; ++it) {
+      if (!Step(cand)) break;
+      const std::uint64_t previous = checksum;
+      checksum = Classify(cand);
+      if (last_step_ < kConvergedStep && checksum == previous) {
+        converged = true;
+        break;
+      }
+    }
+    for (int it = 0; !converged && it < P_.gauss_newton_iterations; ++it) {
+      if (!Step(cand)) break;
+      converged = last_step_ < kConvergedStep;
+    }
+  }
+
+  // Enough inliers, then the measurement (Measure); true if the candidate is the fit.
+  bool Accept(Candidate& cand) {
+    const int total = cand.counts[0] + cand.counts[1];
+    if (total < P_.min_inlier_fraction * ctx_.n) {
+      failure_ = FitFailure::kTooFewInliers;
+      return false;
+    }
+    for (int k = 0; k < cand.model.num_edges; ++k) {
+      EndOffsets(ctx_, cand, k, labels_, proj_, &cand.lo[k], &cand.hi[k]);
+    }
+    ResetKeepingFlags(out_);  // a rejected corner leaves nothing behind for the edge
+    failure_ = Measure(ctx_, req_, P_, cand, out_);
+    return failure_ == FitFailure::kNone;
+  }
+
+ private:
+  // One Gauss-Newton step of Eq. (16) on the current inliers; false if none was possible.
+  bool Step(Candidate* cand) {
+    if (cand->counts[0] + cand->counts[1] < 3) return false;
+    Model stepped = cand->model;
+    double step = 0.0;
+    if (!GaussNewtonStep(ctx_, labels_, &stepped, &step)) return false;
+    cand->model = stepped;
+    last_step_ = step;
+    return true;
+  }
+
+  const Context& ctx_;
+  const FitRequest& req_;
+  const FitParams& P_;
+  FitResult* out_;
+  std::int8_t* labels_;
+  std::vector<double>* proj_;
+  std::vector<double>* gaps_;
+  const std::int8_t* mask_ = nullptr;
+  FitFailure failure_ = FitFailure::kNoConsensus;
+  double last_step_ = 0.0;
+};
+
+// The corner, if it explains enough more than the edge and both its edges are seen.
+bool TryCorner(const Context& ctx, const Model& best_corner, const Candidate& edge_cand,
+               const FitParams& P, double slant, Refiner* r) {
+  Candidate cand;
+  r->Refine(best_corner, &cand);
+  const int total = cand.counts[0] + cand.counts[1];
+  const int need = std::max<int>(P.min_edge_inliers,
+                                 static_cast<int>(std::ceil(P.min_second_edge_fraction * total)));
+  CornerHypothesis refined;
+  refined.corner = cand.model.c;
+  refined.dir_a = cand.model.U0();
+  refined.dir_b = cand.model.U1();
+  refined.degenerate = false;
+  return cand.counts[0] >= need && cand.counts[1] >= need && total >= edge_cand.counts[0] + need &&
+         CornerVisible(refined, ctx.sensor, slant) && r->Accept(cand);
+}
+
+// The edge: inliers beyond the vehicle's known length and those near a perpendicular face
+// behind an end are set aside and the edge refined again; then, if the sensor sees it (Eq. 15),
+// measured.
+bool FitEdge(const Context& ctx, const FitRequest& req, const FitParams& P, double slant,
+             bool edge_labelled, Candidate* edge_cand, std::vector<std::int8_t>* mask_buf,
+             std::vector<double>* proj, Refiner* r) {
+  Candidate& cand = *edge_cand;
+  if (!edge_labelled) r->Classify(&cand);  // the corner overwrote the labels
+  // Longer than the vehicle: keep the inliers that fit in its known length.
+  if (cand.counts[0] >= P.min_edge_inliers && req.shape_known && req.predicted_theta) {
+    mask_buf->assign(ctx.n, 0);
+    if (TrimToKnownLength(ctx, req, P, cand, r->labels(), proj, mask_buf->data())) {
+      r->set_mask(mask_buf->data());
+      r->Refine(cand.model, &cand);
+    }
+  }
+  // A perpendicular face behind an end: its points near the corner are no face points.
+  const double max_depth = std::max(req.length_m, req.width_m) + P.inside_margin_m;
+  if (cand.counts[0] >= P.min_edge_inliers &&
+      FindPerpendicularFaces(ctx, cand, r->labels(), max_depth, proj, &cand.perp)) {
+    if (r->mask() == nullptr) mask_buf->assign(ctx.n, 0);
+    MarkCornerZones(ctx, cand, cand.perp, mask_buf->data());
+    r->set_mask(mask_buf->data());
+    r->Refine(cand.model, &cand);
+    FindPerpendicularFaces(ctx, cand, r->labels(), max_depth, proj, &cand.perp);
+  }
+  if (cand.counts[0] < P.min_edge_inliers) return false;
+  const Extent& e = cand.ext[0];
+  const Eigen::Vector2d mid = cand.model.c + cand.model.U0() * (0.5 * (e.s_min + e.s_max));
+  if (!EdgeVisible(mid, cand.model.U0(), ctx.sensor, slant)) {
+    r->set_failure(FitFailure::kNotVisible);
+    return false;
+  }
+  return r->Accept(cand);
+}
+
+// At least min_points points, all finite; otherwise the failure in *out.
+bool UsablePoints(const FitRequest& req, const FitParams& P, FitResult* out) {
+  const int n = static_cast<int>(req.x.size());
+  if (n < P.min_points) {
+    out->failure = FitFailure::kTooFewPoints;
+    return false;
+  }
+  for (int i = 0; i < n; ++i) {
+    if (!std::isfinite(req.x[i]) || !std::isfinite(req.y[i])) {
+      out->failure = FitFailure::kNonFinitePoint;
+      out->bad_point = i;
+      return false;
+    }
+  }
+  return true;
+}
+
+// Local coordinates (about the first point) and rays once per fit, into the buffers: every
+// classification pass reuses them.
+Context MakeContext(const FitRequest& req, const FitParams& P, std::vector<double>* px,
+                    std::vector<double>* py, std::vector<double>* rx, std::vector<double>* ry) {
+  const int n = static_cast<int>(req.x.size());
+  Context ctx;
+  ctx.n = n;
+  ctx.origin = Eigen::Vector2d(req.x[0], req.y[0]);
+  ctx.sensor = req.sensor_xy - ctx.origin;
+  px->resize(n);
+  py->resize(n);
+  rx->resize(n);
+  ry->resize(n);
+  for (int i = 0; i < n; ++i) {
+    (*px)[i] = static_cast<double>(req.x[i]) - ctx.origin.x();
+    (*py)[i] = static_cast<double>(req.y[i]) - ctx.origin.y();
+    const Eigen::Vector2d ray = ctx.Ray({(*px)[i], (*py)[i]});
+    (*rx)[i] = ray.x();
+    (*ry)[i] = ray.y();
+  }
+  ctx.px = px->data();
+  ctx.py = py->data();
+  ctx.rx = rx->data();
+  ctx.ry = ry->data();
+  ctx.sigma2 = req.range_sigma_m * req.range_sigma_m;
+  ctx.surface2 = P.surface_std_m * P.surface_std_m;
+  ctx.k2 = P.inlier_sigmas * P.inlier_sigmas;
+  ctx.min_t2 = P.min_inlier_distance_m * P.min_inlier_distance_m;
+  return ctx;
 }
 
 }  // namespace
@@ -896,280 +1272,34 @@ void SegmentFitter::Fit(const FitRequest& req, FitResult* out) {
   ResetKeepingFlags(out);
   out->point_edge.assign(n, FitResult::kOutlier);
   out->point_in_fit.assign(n, 0);
-  if (n < P.min_points) {
-    out->failure = FitFailure::kTooFewPoints;
-    return;
-  }
-  for (int i = 0; i < n; ++i) {
-    if (!std::isfinite(req.x[i]) || !std::isfinite(req.y[i])) {
-      out->failure = FitFailure::kNonFinitePoint;
-      out->bad_point = i;
-      return;
-    }
-  }
-
-  Context ctx;
-  ctx.n = n;
-  ctx.origin = Eigen::Vector2d(req.x[0], req.y[0]);
-  ctx.sensor = req.sensor_xy - ctx.origin;
-  // Local coordinates and rays once per fit: every classification pass reuses them.
-  px_.resize(n);
-  py_.resize(n);
-  rx_.resize(n);
-  ry_.resize(n);
-  for (int i = 0; i < n; ++i) {
-    px_[i] = static_cast<double>(req.x[i]) - ctx.origin.x();
-    py_[i] = static_cast<double>(req.y[i]) - ctx.origin.y();
-    const Eigen::Vector2d ray = ctx.Ray({px_[i], py_[i]});
-    rx_[i] = ray.x();
-    ry_[i] = ray.y();
-  }
-  ctx.px = px_.data();
-  ctx.py = py_.data();
-  ctx.rx = rx_.data();
-  ctx.ry = ry_.data();
-  ctx.sigma2 = req.range_sigma_m * req.range_sigma_m;
-  ctx.surface2 = P.surface_std_m * P.surface_std_m;
-  ctx.k2 = P.inlier_sigmas * P.inlier_sigmas;
-  ctx.min_t2 = P.min_inlier_distance_m * P.min_inlier_distance_m;
+  if (!UsablePoints(req, P, out)) return;
+  const Context ctx = MakeContext(req, P, &px_, &py_, &rx_, &ry_);
   const double slant = DegToRad(P.min_slant_deg);
-
   // A small-state engine: seeding std::mt19937 (2.5 kB of state) would cost more than a small
   // fit; minstd is plenty for drawing sample indices.
   std::minstd_rand rng(static_cast<std::uint_fast32_t>((req.seed ^ (req.seed >> 32)) % 2147483646u) + 1u);
-
-  // Scoring subset: one point drawn from each of S equal strata of the point order.
-  const int S = std::min(n, P.max_scoring_points);
-  sx_.resize(S);
-  sy_.resize(S);
-  srx_.resize(S);
-  sry_.resize(S);
-  for (int i = 0; i < S; ++i) {
-    const int lo = static_cast<int>(static_cast<std::int64_t>(i) * n / S);
-    const int hi = static_cast<int>(static_cast<std::int64_t>(i + 1) * n / S) - 1;
-    const int idx = hi > lo ? std::uniform_int_distribution<int>(lo, hi)(rng) : lo;
-    const Eigen::Vector2d p = ctx.P(idx);
-    const Eigen::Vector2d ray = ctx.RayAt(idx);
-    sx_[i] = p.x();
-    sy_[i] = p.y();
-    srx_[i] = ray.x();
-    sry_[i] = ray.y();
-  }
-  std::uniform_int_distribution<int> pick(0, S - 1);
-  auto subset_point = [&](int i) { return Eigen::Vector2d(sx_[i], sy_[i]); };
-  const double min_sep2 = P.min_sample_separation_m * P.min_sample_separation_m;
-
-  // RANSAC, straight edges (2 points).
-  Model best_edge;
-  double best_edge_cost = std::numeric_limits<double>::infinity();
-  {
-    int needed = P.max_edge_iterations;
-    for (int it = 0; it < P.max_edge_iterations; ++it) {
-      if (it >= needed && it >= P.min_iterations) break;
-      const int i = pick(rng), j = pick(rng);
-      if (i == j) continue;
-      const Eigen::Vector2d pi = subset_point(i), pj = subset_point(j);
-      const Eigen::Vector2d d = pj - pi;
-      if (d.squaredNorm() < std::max(min_sep2, 1e-18)) continue;
-      const Eigen::Vector2d u = d.normalized();
-      const Eigen::Vector2d mid = 0.5 * (pi + pj);
-      if (!EdgeVisible(mid, u, ctx.sensor, slant)) continue;
-      const Eigen::Vector2d nrm = Perp(u);
-      double cost = 0.0;
-      int inliers = 0;
-      for (int s = 0; s < S; ++s) {
-        const double r = nrm.x() * (sx_[s] - mid.x()) + nrm.y() * (sy_[s] - mid.y());
-        const double ca = nrm.x() * srx_[s] + nrm.y() * sry_[s];
-        const double e = r * r / ctx.Threshold2(ctx.PerpVar(ca));
-        if (e < 1.0) {
-          cost += e;
-          ++inliers;
-        } else {
-          cost += 1.0;
-        }
-      }
-      if (cost < best_edge_cost) {
-        best_edge_cost = cost;
-        best_edge.num_edges = 1;
-        best_edge.c = mid;
-        best_edge.phi = AngleOf(u);
-        const double w = static_cast<double>(inliers) / S;
-        needed = IterationsFor(w * w, P.ransac_confidence);
-      }
-    }
-  }
-
-  // RANSAC, corners (3 points, the three corners of Figure 3 each, filtered by Eq. 15).
-  Model best_corner;
-  double best_corner_cost = std::numeric_limits<double>::infinity();
-  {
-    int needed = P.max_corner_iterations;
-    for (int it = 0; it < P.max_corner_iterations && S >= 3; ++it) {
-      if (it >= needed && it >= P.min_iterations) break;
-      const int idx[3] = {pick(rng), pick(rng), pick(rng)};
-      if (idx[0] == idx[1] || idx[1] == idx[2] || idx[0] == idx[2]) continue;
-      const Eigen::Vector2d q[3] = {subset_point(idx[0]), subset_point(idx[1]),
-                                    subset_point(idx[2])};
-      const auto hyps = CornerHypothesesFromPoints(q[0], q[1], q[2]);
-      for (int k = 0; k < 3; ++k) {
-        const CornerHypothesis& h = hyps[k];
-        if (h.degenerate || h.a_both_ways) continue;
-        if ((q[(k + 1) % 3] - q[(k + 2) % 3]).squaredNorm() < min_sep2) continue;
-        if ((q[k] - h.corner).squaredNorm() < min_sep2) continue;
-        if (!CornerVisible(h, ctx.sensor, slant)) continue;
-        const Eigen::Vector2d u0 = Cross(h.dir_a, h.dir_b) > 0.0 ? h.dir_a : h.dir_b;
-        const Eigen::Vector2d u1 = Perp(u0);
-        double cost = 0.0;
-        int n0 = 0, n1 = 0;
-        for (int s = 0; s < S; ++s) {
-          const double vx = sx_[s] - h.corner.x(), vy = sy_[s] - h.corner.y();
-          const double a0 = u0.x() * vx + u0.y() * vy;  // along edge 0 = residual of edge 1
-          const double a1 = u1.x() * vx + u1.y() * vy;  // along edge 1 = residual of edge 0
-          const double t0 = ctx.Threshold2(ctx.PerpVar(u1.x() * srx_[s] + u1.y() * sry_[s]));
-          const double t1 = ctx.Threshold2(ctx.PerpVar(u0.x() * srx_[s] + u0.y() * sry_[s]));
-          const double e0 = (a0 >= 0.0 || a0 * a0 < t0) ? a1 * a1 / t0 : 1.0;
-          const double e1 = (a1 >= 0.0 || a1 * a1 < t1) ? a0 * a0 / t1 : 1.0;
-          if (e0 < 1.0 && e0 <= e1) {
-            cost += e0;
-            ++n0;
-          } else if (e1 < 1.0) {
-            cost += e1;
-            ++n1;
-          } else {
-            cost += 1.0;
-          }
-        }
-        if (cost < best_corner_cost) {
-          best_corner_cost = cost;
-          best_corner.num_edges = 2;
-          best_corner.c = h.corner;
-          best_corner.phi = AngleOf(u0);
-          const double wa = static_cast<double>(n0) / S, wb = static_cast<double>(n1) / S;
-          // A triple is a good sample if it holds points of both edges and no outlier.
-          needed = IterationsFor(3.0 * wa * wb * (wa + wb), P.ransac_confidence);
-        }
-      }
-    }
-  }
-
-  // Refinement on all points, then the choice between corner and edge.
-  FitFailure failure = FitFailure::kNoConsensus;
-  std::int8_t* labels = out->point_edge.data();
-  // Inliers of the candidate's model into labels, their runs and extents.
-  const std::int8_t* mask = nullptr;  // single edge: ambiguous and excluded points
-  auto classify = [&](Candidate* cand) {
-    std::uint64_t checksum = Classify(ctx, cand->model, mask, labels, cand->counts);
-    for (int k = 0; k < cand->model.num_edges; ++k) {
-      cand->ext[k] = GapFilter(ctx, cand->model, k, P.max_inlier_gap_m, P.max_gap_spacings,
-                               labels, &proj_, &gaps_);
-      cand->counts[k] = cand->ext[k].n;
-      checksum = checksum * 31 + static_cast<std::uint64_t>(cand->ext[k].n);
-    }
-    return checksum;
-  };
-  // Eq. (16) from a RANSAC sample: the inlier set changes as the model improves, so steps and
-  // classification alternate until the step is negligible and the inliers stay the same (the
-  // model is then the minimum of Eq. 16 over exactly the inliers reported and used for R).
-  auto refine = [&](const Model& start, Candidate* cand) {
-    cand->model = start;
-    std::uint64_t checksum = classify(cand);
-    bool converged = false;
-    for (int it = 0; it < P.gauss_newton_iterations; ++it) {
-      if (cand->counts[0] + cand->counts[1] < 3) break;
-      Model stepped = cand->model;
-      double step = 0.0;
-      if (!GaussNewtonStep(ctx, labels, &stepped, &step)) break;
-      cand->model = stepped;
-      const std::uint64_t previous = checksum;
-      checksum = classify(cand);
-      if (step < kConvergedStep && checksum == previous) {
-        converged = true;
-        break;
-      }
-    }
-    // The inlier set can oscillate between two models (a point at the threshold): then finish on
-    // the last classification held fixed, so the model is the minimum of Eq. (16) over exactly
-    // the inliers that are reported and enter R.
-    for (int it = 0; !converged && it < P.gauss_newton_iterations; ++it) {
-      if (cand->counts[0] + cand->counts[1] < 3) break;
-      Model stepped = cand->model;
-      double step = 0.0;
-      if (!GaussNewtonStep(ctx, labels, &stepped, &step)) break;
-      cand->model = stepped;
-      converged = step < kConvergedStep;
-    }
-  };
-  auto accept = [&](Candidate& cand) {
-    const int total = cand.counts[0] + cand.counts[1];
-    if (total < P.min_inlier_fraction * n) {
-      failure = FitFailure::kTooFewInliers;
-      return false;
-    }
-    for (int k = 0; k < cand.model.num_edges; ++k) {
-      EndOffsets(ctx, cand, k, labels, &proj_, &cand.lo[k], &cand.hi[k]);
-    }
-    ResetKeepingFlags(out);  // a rejected corner leaves nothing behind for the edge
-    failure = Measure(ctx, req, P, cand, out);
-    return failure == FitFailure::kNone;
-  };
-
-  // The best edge first: a corner must explain what it cannot.
+  const Subset sub = DrawSubset(ctx, P.max_scoring_points, rng, &sx_, &sy_, &srx_, &sry_);
+  std::uniform_int_distribution<int> pick(0, sub.size - 1);
+  const Model best_edge = RansacEdge(ctx, sub, P, slant, pick, rng);
+  const Model best_corner = RansacCorner(ctx, sub, P, slant, pick, rng);
+  // Refinement on all points, then the choice between corner and edge: the best edge first, a
+  // corner must explain what it cannot.
+  Refiner r(ctx, req, P, out, &proj_, &gaps_);
   Candidate edge_cand;
-  if (best_edge.num_edges == 1) refine(best_edge, &edge_cand);
-  bool edge_labelled = true;  // labels hold edge_cand's classification
+  if (best_edge.num_edges == 1) r.Refine(best_edge, &edge_cand);
+  bool edge_labelled = true;  // the labels hold edge_cand's classification
   if (best_corner.num_edges == 2) {
-    Candidate cand;
-    refine(best_corner, &cand);
     edge_labelled = false;
-    const int total = cand.counts[0] + cand.counts[1];
-    const int need = std::max<int>(P.min_edge_inliers,
-                                   static_cast<int>(std::ceil(P.min_second_edge_fraction * total)));
-    CornerHypothesis refined;
-    refined.corner = cand.model.c;
-    refined.dir_a = cand.model.U0();
-    refined.dir_b = cand.model.U1();
-    refined.degenerate = false;
-    if (cand.counts[0] >= need && cand.counts[1] >= need && total >= edge_cand.counts[0] + need &&
-        CornerVisible(refined, ctx.sensor, slant) && accept(cand)) {
-      return;
-    }
+    if (TryCorner(ctx, best_corner, edge_cand, P, slant, &r)) return;
   }
-  if (best_edge.num_edges == 1) {
-    Candidate& cand = edge_cand;
-    if (!edge_labelled) classify(&cand);  // the corner overwrote the labels
-    // Longer than the vehicle: keep the inliers that fit in its known length.
-    if (cand.counts[0] >= P.min_edge_inliers && req.shape_known && req.predicted_theta) {
-      mask_.assign(n, 0);
-      if (TrimToKnownLength(ctx, req, P, cand, labels, &proj_, mask_.data())) {
-        mask = mask_.data();
-        refine(cand.model, &cand);
-      }
-    }
-    // A perpendicular face behind an end: its points near the corner are no face points.
-    const double max_depth = std::max(req.length_m, req.width_m) + P.inside_margin_m;
-    if (cand.counts[0] >= P.min_edge_inliers &&
-        FindPerpendicularFaces(ctx, cand, labels, max_depth, &proj_, &cand.perp)) {
-      if (mask == nullptr) mask_.assign(n, 0);
-      MarkCornerZones(ctx, cand, cand.perp, mask_.data());
-      mask = mask_.data();
-      refine(cand.model, &cand);
-      FindPerpendicularFaces(ctx, cand, labels, max_depth, &proj_, &cand.perp);
-    }
-    if (cand.counts[0] >= P.min_edge_inliers) {
-      const Extent& e = cand.ext[0];
-      const Eigen::Vector2d mid = cand.model.c + cand.model.U0() * (0.5 * (e.s_min + e.s_max));
-      if (!EdgeVisible(mid, cand.model.U0(), ctx.sensor, slant)) {
-        failure = FitFailure::kNotVisible;
-      } else if (accept(cand)) {
-        return;
-      }
-    }
+  if (best_edge.num_edges == 1 &&
+      FitEdge(ctx, req, P, slant, edge_labelled, &edge_cand, &mask_, &proj_, &r)) {
+    return;
   }
   // No fit: reset the partial outputs.
   ResetKeepingFlags(out);
   std::fill(out->point_edge.begin(), out->point_edge.end(), FitResult::kOutlier);
   out->point_in_fit.assign(n, 0);
-  out->failure = failure;
+  out->failure = r.failure();
 }
-
 }  // namespace vtrack

@@ -90,9 +90,27 @@ Preprocessor::Preprocessor(const PreprocessParams& params) : params_(params) {}
 PreprocessResult Preprocessor::Run(const LadarScan& scan, const PoseHistory& poses,
                                    std::int64_t max_extrapolation_us, WorldPoints* out) {
   PreprocessResult result;
-  const std::size_t n = scan.size();
-  result.stats.input = static_cast<std::int64_t>(n);
+  result.stats.input = static_cast<std::int64_t>(scan.size());
+  // Compensation: the sensor's pose at knots over the sweep, each return placed with the pose
+  // interpolated linearly between the knots around its time.
+  if (!ComputeKnots(scan, poses, max_extrapolation_us, &result)) {
+    out->clear();
+    return result;
+  }
+  Compensate(scan, &result.stats, out);
+  // Ground: a grid of local ground heights (3-D clouds), or a fixed band.
+  const bool cloud_3d = scan.num_rings >= params_.ground_min_rings;
+  if (cloud_3d && params_.ground == PreprocessParams::Ground::kGrid) {
+    RemoveGround(result.sensor_xy, out, &result.stats);
+  } else if (cloud_3d && params_.ground == PreprocessParams::Ground::kBand) {
+    RemoveGroundBand(out, &result.stats);
+  }
+  result.stats.kept = static_cast<std::int64_t>(out->size());
+  return result;
+}
 
+bool Preprocessor::ComputeKnots(const LadarScan& scan, const PoseHistory& poses,
+                                std::int64_t max_extrapolation_us, PreprocessResult* result) {
   // Pose knots over the sweep [utime, utime + T].
   const std::int64_t sweep = std::max<std::int64_t>(0, scan.sweep_duration_us);
   const std::int64_t step = params_.knot_us;
@@ -106,10 +124,9 @@ PreprocessResult Preprocessor::Run(const LadarScan& scan, const PoseHistory& pos
     PoseHistory::LookupStatus st;
     const auto world_from_body = poses.At(t, max_extrapolation_us, &st);
     if (!world_from_body) {
-      out->clear();
-      result.status = CompensationStatus::kNoPose;
-      result.failed_lookup = st;
-      return result;
+      result->status = CompensationStatus::kNoPose;
+      result->failed_lookup = st;
+      return false;
     }
     if (st == PoseHistory::LookupStatus::kExtrapolated) extrapolated = true;
     if (k == 0) world_from_body_start = *world_from_body;
@@ -120,24 +137,28 @@ PreprocessResult Preprocessor::Run(const LadarScan& scan, const PoseHistory& pos
     knot_d_[static_cast<std::size_t>(k)] =
         knot_m_[static_cast<std::size_t>(k + 1)] - knot_m_[static_cast<std::size_t>(k)];
   }
-  result.status = extrapolated ? CompensationStatus::kExtrapolated : CompensationStatus::kOk;
-  result.world_from_body_start = world_from_body_start;
-  {
-    const std::int64_t mid = scan.utime + sweep / 2;
-    PoseHistory::LookupStatus st;
-    const auto world_from_body = poses.At(mid, max_extrapolation_us, &st);
-    const Eigen::Isometry3d wb = world_from_body ? *world_from_body : world_from_body_start;
-    result.sensor_xy = (wb * scan.body_from_sensor).translation().head<2>();
-  }
+  result->status = extrapolated ? CompensationStatus::kExtrapolated : CompensationStatus::kOk;
+  result->world_from_body_start = world_from_body_start;
+  // The sensor's origin at mid-sweep (the centre of the ground grid and the segmentation).
+  const std::int64_t mid = scan.utime + sweep / 2;
+  PoseHistory::LookupStatus st;
+  const auto world_from_body = poses.At(mid, max_extrapolation_us, &st);
+  const Eigen::Isometry3d wb = world_from_body ? *world_from_body : world_from_body_start;
+  result->sensor_xy = (wb * scan.body_from_sensor).translation().head<2>();
+  return true;
+}
 
+void Preprocessor::Compensate(const LadarScan& scan, PreprocessStats* stats, WorldPoints* out) {
+  const std::size_t n = scan.size();
+  const std::int64_t sweep = std::max<std::int64_t>(0, scan.sweep_duration_us);
+  const std::int64_t step = params_.knot_us;
+  const std::int64_t num_intervals = static_cast<std::int64_t>(knot_d_.size());
   // Body-frame height of a return: the z row of body_from_sensor (the mounting is rigid).
   const Eigen::Matrix<double, 1, 4> body_z = scan.body_from_sensor.matrix().row(2);
   const double min_r2 = params_.min_range * params_.min_range;
   const double max_r2 = params_.max_range * params_.max_range;
   const bool has_ring = scan.ring.size() == n;
   const bool has_dt = scan.dt_us.size() == n;
-  const bool cloud_3d = scan.num_rings >= params_.ground_min_rings;
-  const bool grid_ground = cloud_3d && params_.ground == PreprocessParams::Ground::kGrid;
   const double inv_step = 1.0 / static_cast<double>(step);
   if (fraction_.size() != static_cast<std::size_t>(step) + 1) {
     fraction_.resize(static_cast<std::size_t>(step) + 1);
@@ -162,17 +183,17 @@ PreprocessResult Preprocessor::Run(const LadarScan& scan, const PoseHistory& pos
   for (std::size_t i = 0; i < n; ++i) {
     const double px = scan.x[i], py = scan.y[i], pz = scan.z[i];
     if (!std::isfinite(px) || !std::isfinite(py) || !std::isfinite(pz)) {
-      ++result.stats.nonfinite;
+      ++stats->nonfinite;
       continue;
     }
     const double r2 = px * px + py * py + pz * pz;
     if (r2 < min_r2 || r2 > max_r2) {
-      ++result.stats.out_of_range;
+      ++stats->out_of_range;
       continue;
     }
     const std::int64_t dt = has_dt ? scan.dt_us[i] : 0;
     if (dt < 0 || dt > sweep) {
-      ++result.stats.bad_time;
+      ++stats->bad_time;
       continue;
     }
     // dt / step without a 64-bit division per return: a floating-point guess, corrected to the
@@ -205,46 +226,75 @@ PreprocessResult Preprocessor::Run(const LadarScan& scan, const PoseHistory& pos
   out->height.resize(w);
   out->index.resize(w);
   out->ring.resize(w);
+}
 
-  if (grid_ground) {
-    RemoveGround(result.sensor_xy, out, &result.stats);
-  } else if (cloud_3d && params_.ground == PreprocessParams::Ground::kBand) {
-    std::size_t w = 0;
-    for (std::size_t i = 0; i < out->size(); ++i) {
-      const float h = out->height[i] - static_cast<float>(params_.ground_height_body);
-      if (h < params_.min_height || h > params_.max_height) continue;
-      out->x[w] = out->x[i];
-      out->y[w] = out->y[i];
-      out->height[w] = h;
-      out->index[w] = out->index[i];
-      out->ring[w] = out->ring[i];
-      ++w;
-    }
-    result.stats.ground = static_cast<std::int64_t>(out->size() - w);
-    out->x.resize(w);
-    out->y.resize(w);
-    out->height.resize(w);
-    out->index.resize(w);
-    out->ring.resize(w);
+namespace {
+
+// The ground level of a scan is the median of the lowest return per occupied cell within this
+// distance of the sensor, where most cells see the road.
+constexpr double kGroundLevelRadius = 20.0;  // [m]
+
+// Keeps the returns whose height above the ground (ground_of(i, height)) lies in
+// [min_h, max_h], storing that height; counts the others as ground.
+template <class GroundOf>
+void KeepAboveGround(double min_h, double max_h, GroundOf ground_of, WorldPoints* pts,
+                     PreprocessStats* stats) {
+  const std::size_t n = pts->size();
+  std::size_t w = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const float h = pts->height[i] - ground_of(i);
+    if (h < min_h || h > max_h) continue;
+    pts->x[w] = pts->x[i];
+    pts->y[w] = pts->y[i];
+    pts->height[w] = h;
+    pts->index[w] = pts->index[i];
+    pts->ring[w] = pts->ring[i];
+    ++w;
   }
-  result.stats.kept = static_cast<std::int64_t>(out->size());
-  return result;
+  stats->ground = static_cast<std::int64_t>(n - w);
+  pts->x.resize(w);
+  pts->y.resize(w);
+  pts->height.resize(w);
+  pts->index.resize(w);
+  pts->ring.resize(w);
+}
+
+}  // namespace
+
+void Preprocessor::RemoveGroundBand(WorldPoints* out, PreprocessStats* stats) const {
+  // Heights above a flat ground at ground_height_body.
+  const float ground = static_cast<float>(params_.ground_height_body);
+  KeepAboveGround(params_.min_height, params_.max_height, [ground](std::size_t) { return ground; },
+                  out, stats);
 }
 
 void Preprocessor::RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts,
                                 PreprocessStats* stats) {
   const double cell = params_.ground_cell;
-  const int side = static_cast<int>(std::ceil(2.0 * params_.max_range / cell)) + 3;
-  const double x0 = center.x() - 0.5 * side * cell;
-  const double y0 = center.y() - 0.5 * side * cell;
-  constexpr float kInf = std::numeric_limits<float>::infinity();
-  cell_min_.assign(static_cast<std::size_t>(side) * side, kInf);
-  cell_ground_.assign(static_cast<std::size_t>(side) * side, std::numeric_limits<float>::quiet_NaN());
-  const std::size_t n = pts->size();
+  GroundGrid grid;
+  grid.side = static_cast<int>(std::ceil(2.0 * params_.max_range / cell)) + 3;
+  grid.x0 = center.x() - 0.5 * grid.side * cell;
+  grid.y0 = center.y() - 0.5 * grid.side * cell;
+  BinLowestReturns(grid, *pts);
+  BoundByGrade(grid);
+  const float level = GroundLevel(grid);
+  cell_ground_.assign(static_cast<std::size_t>(grid.side) * grid.side,
+                      std::numeric_limits<float>::quiet_NaN());
+  // Locals: the stores below could alias the parameters, which would be reloaded per return.
+  const double min_h = params_.min_height, max_h = params_.max_height;
+  KeepAboveGround(min_h, max_h,
+                  [&](std::size_t i) { return CellGround(grid, point_cell_[i], level); }, pts, stats);
+}
+
+void Preprocessor::BinLowestReturns(const GroundGrid& grid, const WorldPoints& pts) {
+  const double cell = params_.ground_cell;
+  const int side = grid.side;
+  cell_min_.assign(static_cast<std::size_t>(side) * side, std::numeric_limits<float>::infinity());
+  const std::size_t n = pts.size();
   point_cell_.resize(n);
-  const double* const px = pts->x.data();
-  const double* const py = pts->y.data();
-  const float* const ph = pts->height.data();
+  const double* const px = pts.x.data();
+  const double* const py = pts.y.data();
+  const float* const ph = pts.height.data();
   std::int32_t* const pc = point_cell_.data();
   float* const cmin = cell_min_.data();
   // Within max_range of the sensor, hence inside the grid (with one spare ring of cells) — unless
@@ -260,45 +310,49 @@ void Preprocessor::RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts,
     return c >= 1.0 && c <= side - 2.0 ? static_cast<int>(c) : (c > side - 2.0 ? side - 2 : 1);
   };
   for (std::size_t i = 0; i < n; ++i) {
-    const int cx = cell_index(px[i] - x0);
-    const int cy = cell_index(py[i] - y0);
+    const int cx = cell_index(px[i] - grid.x0);
+    const int cy = cell_index(py[i] - grid.y0);
     const std::int32_t c = cy * side + cx;
     pc[i] = c;
     cmin[c] = std::min(cmin[c], ph[i]);
   }
+}
+
+void Preprocessor::BoundByGrade(const GroundGrid& grid) {
   // Upper bound of the ground per cell: min over cells c' of cell_min(c') + grade * |c - c'|, by
   // the two raster passes of a 3x3 chamfer distance transform (Borgefors 1986; diagonal steps
   // weighted sqrt(2), which overstates a Euclidean distance by at most 8 %). Written here: OpenCV's
   // distanceTransform computes distances to zero pixels, not this lower envelope of heights.
+  const int side = grid.side;
   cell_bound_ = cell_min_;
-  {
-    const float a = static_cast<float>(params_.ground_max_grade * cell);
-    const float d = a * static_cast<float>(std::sqrt(2.0));
-    float* const b = cell_bound_.data();
-    for (int cy = 1; cy < side - 1; ++cy) {
-      for (int cx = 1; cx < side - 1; ++cx) {
-        const std::ptrdiff_t c = static_cast<std::ptrdiff_t>(cy) * side + cx;
-        b[c] = std::min({b[c], b[c - 1] + a, b[c - side - 1] + d, b[c - side] + a,
-                         b[c - side + 1] + d});
-      }
-    }
-    for (int cy = side - 2; cy >= 1; --cy) {
-      for (int cx = side - 2; cx >= 1; --cx) {
-        const std::ptrdiff_t c = static_cast<std::ptrdiff_t>(cy) * side + cx;
-        b[c] = std::min({b[c], b[c + 1] + a, b[c + side + 1] + d, b[c + side] + a,
-                         b[c + side - 1] + d});
-      }
+  const float a = static_cast<float>(params_.ground_max_grade * params_.ground_cell);
+  const float d = a * static_cast<float>(std::sqrt(2.0));
+  float* const b = cell_bound_.data();
+  for (int cy = 1; cy < side - 1; ++cy) {
+    for (int cx = 1; cx < side - 1; ++cx) {
+      const std::ptrdiff_t c = static_cast<std::ptrdiff_t>(cy) * side + cx;
+      b[c] = std::min({b[c], b[c - 1] + a, b[c - side - 1] + d, b[c - side] + a,
+                       b[c - side + 1] + d});
     }
   }
-  // Overall ground level: median of the lowest return per occupied cell within 20 m of the
-  // sensor, where most cells see the road.
+  for (int cy = side - 2; cy >= 1; --cy) {
+    for (int cx = side - 2; cx >= 1; --cx) {
+      const std::ptrdiff_t c = static_cast<std::ptrdiff_t>(cy) * side + cx;
+      b[c] = std::min({b[c], b[c + 1] + a, b[c + side + 1] + d, b[c + side] + a,
+                       b[c + side - 1] + d});
+    }
+  }
+}
+
+float Preprocessor::GroundLevel(const GroundGrid& grid) const {
+  const int side = grid.side;
   std::vector<float> near_mins;
-  const int r_cells = static_cast<int>(std::ceil(20.0 / cell));
+  const int r_cells = static_cast<int>(std::ceil(kGroundLevelRadius / params_.ground_cell));
   const int ccx = side / 2, ccy = side / 2;
   for (int cy = std::max(0, ccy - r_cells); cy <= std::min(side - 1, ccy + r_cells); ++cy) {
     for (int cx = std::max(0, ccx - r_cells); cx <= std::min(side - 1, ccx + r_cells); ++cx) {
       const float m = cell_min_[static_cast<std::size_t>(cy * side + cx)];
-      if (m < kInf) near_mins.push_back(m);
+      if (m < std::numeric_limits<float>::infinity()) near_mins.push_back(m);
     }
   }
   float level = static_cast<float>(params_.ground_height_body);
@@ -307,45 +361,32 @@ void Preprocessor::RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts,
     std::nth_element(near_mins.begin(), mid, near_mins.end());
     level = *mid;
   }
-  const float tol = static_cast<float>(params_.ground_tolerance);
-  // Locals: the stores below could alias the parameters, which would be reloaded per return.
-  const double min_h = params_.min_height, max_h = params_.max_height;
-  std::size_t w = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::int32_t c = point_cell_[i];
-    float& g = cell_ground_[static_cast<std::size_t>(c)];
-    if (std::isnan(g)) {
-      float m = kInf;
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          m = std::min(m, cell_min_[static_cast<std::size_t>(c + dy * side + dx)]);
-        }
-      }
-      const int cx = c % side, cy = c / side;
-      const float tol_here =
-          tol + static_cast<float>(params_.ground_max_slope * cell *
-                                   std::hypot(cx - side / 2, cy - side / 2));
-      g = std::clamp(m, level - tol_here, level + tol_here);
-      // Above the scan's level by more than the tolerance (far cells only): no higher than the
-      // lowest returns around allow, and no lower than that tolerance (a single low outlier,
-      // which real clouds have, must not pull down the ground of the cells around it).
-      if (g > level + tol) g = std::max(level + tol, std::min(g, cell_bound_[static_cast<std::size_t>(c)]));
+  return level;
+}
+
+float Preprocessor::CellGround(const GroundGrid& grid, std::int32_t c, float level) {
+  float& g = cell_ground_[static_cast<std::size_t>(c)];
+  if (!std::isnan(g)) return g;  // computed once per cell
+  const int side = grid.side;
+  // The lowest return of the 3 x 3 cells around, within the tolerance (growing with the
+  // distance from the sensor by ground_max_slope) of the scan's level.
+  float m = std::numeric_limits<float>::infinity();
+  for (int dy = -1; dy <= 1; ++dy) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      m = std::min(m, cell_min_[static_cast<std::size_t>(c + dy * side + dx)]);
     }
-    const float h = pts->height[i] - g;
-    if (h < min_h || h > max_h) continue;
-    pts->x[w] = pts->x[i];
-    pts->y[w] = pts->y[i];
-    pts->height[w] = h;
-    pts->index[w] = pts->index[i];
-    pts->ring[w] = pts->ring[i];
-    ++w;
   }
-  stats->ground = static_cast<std::int64_t>(n - w);
-  pts->x.resize(w);
-  pts->y.resize(w);
-  pts->height.resize(w);
-  pts->index.resize(w);
-  pts->ring.resize(w);
+  const float tol = static_cast<float>(params_.ground_tolerance);
+  const int cx = c % side, cy = c / side;
+  const float tol_here =
+      tol + static_cast<float>(params_.ground_max_slope * params_.ground_cell *
+                               std::hypot(cx - side / 2, cy - side / 2));
+  g = std::clamp(m, level - tol_here, level + tol_here);
+  // Above the scan's level by more than the tolerance (far cells only): no higher than the
+  // lowest returns around allow, and no lower than that tolerance (a single low outlier, which
+  // real clouds have, must not pull down the ground of the cells around it).
+  if (g > level + tol) g = std::max(level + tol, std::min(g, cell_bound_[static_cast<std::size_t>(c)]));
+  return g;
 }
 
 }  // namespace vtrack

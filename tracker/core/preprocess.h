@@ -109,7 +109,25 @@ class Preprocessor {
   const PreprocessParams& params() const { return params_; }
 
  private:
+  // The knots' poses and the sensor's origin at mid-sweep in *result; false (status kNoPose)
+  // if a knot has no pose.
+  bool ComputeKnots(const LadarScan& scan, const PoseHistory& poses,
+                    std::int64_t max_extrapolation_us, PreprocessResult* result);
+  // Every usable return placed in the world (counts what is not in *stats).
+  void Compensate(const LadarScan& scan, PreprocessStats* stats, WorldPoints* out);
+  // The ground grid (cells of ground_cell around the sensor, one spare ring at the edge).
+  struct GroundGrid {
+    int side = 0;          // [cells]
+    double x0 = 0, y0 = 0; // [m] world corner
+  };
+  // Ground: per cell the local ground height (the lowest return around, bounded by the scan's
+  // level and the grade), and returns within [min_height, max_height] above it kept.
   void RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts, PreprocessStats* stats);
+  void BinLowestReturns(const GroundGrid& grid, const WorldPoints& pts);
+  void BoundByGrade(const GroundGrid& grid);
+  float GroundLevel(const GroundGrid& grid) const;
+  float CellGround(const GroundGrid& grid, std::int32_t cell, float level);
+  void RemoveGroundBand(WorldPoints* pts, PreprocessStats* stats) const;
 
   PreprocessParams params_;
   // Knots: world_from_sensor rows x and y (3x4 each, as 2x4) and their differences.

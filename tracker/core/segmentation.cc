@@ -120,6 +120,21 @@ void Segmenter::RunScanLine(const WorldPoints& pts, const Eigen::Vector2d& senso
 }
 
 void Segmenter::RunGrid(const WorldPoints& pts, const Eigen::Vector2d& sensor_xy, Segments* out) {
+  BinReturns(pts, sensor_xy);
+  SortReturnsByCell(pts.size());
+  // Connected components of occupied cells (depth-first, explicit stack).
+  const std::size_t m = occupied_.size();
+  slot_label_.assign(m, -1);
+  std::int32_t label = 0;
+  for (std::size_t seed = 0; seed < m; ++seed) {
+    if (slot_label_[seed] >= 0) continue;
+    const auto begin = static_cast<std::int32_t>(out->point.size());
+    CollectComponent(seed, label++, out);
+    Finish(pts, begin, out);
+  }
+}
+
+void Segmenter::BinReturns(const WorldPoints& pts, const Eigen::Vector2d& sensor_xy) {
   const std::size_t n = pts.size();
   const std::size_t cells = static_cast<std::size_t>(side_) * static_cast<std::size_t>(side_);
   if (cells_.size() != cells) {
@@ -136,8 +151,8 @@ void Segmenter::RunGrid(const WorldPoints& pts, const Eigen::Vector2d& sensor_xy
   occupied_.clear();
   slot_count_.clear();
   point_cell_.resize(n);
-  // Pass 1: cell slot of every return (outside the grid: -1), occupied cells and their counts.
-  // The outermost ring of cells is never used, so neighbour look-ups need no bounds checks.
+  // The cell slot of every return (outside the grid: -1), occupied cells and their counts. The
+  // outermost ring of cells is never used, so neighbour look-ups need no bounds checks.
   for (std::size_t i = 0; i < n; ++i) {
     const double fx = (pts.x[i] - x0) * inv, fy = (pts.y[i] - y0) * inv;
     if (!(fx >= 1.0 && fy >= 1.0 && fx < side_ - 1 && fy < side_ - 1)) {
@@ -156,6 +171,9 @@ void Segmenter::RunGrid(const WorldPoints& pts, const Eigen::Vector2d& sensor_xy
     point_cell_[i] = cell.slot;
     ++slot_count_[static_cast<std::size_t>(cell.slot)];
   }
+}
+
+void Segmenter::SortReturnsByCell(std::size_t n) {
   // Counting sort of returns by cell slot.
   const std::size_t m = occupied_.size();
   slot_start_.resize(m + 1);
@@ -168,36 +186,30 @@ void Segmenter::RunGrid(const WorldPoints& pts, const Eigen::Vector2d& sensor_xy
     const auto s = static_cast<std::size_t>(point_cell_[i]);
     sorted_[static_cast<std::size_t>(slot_count_[s]++)] = static_cast<std::int32_t>(i);
   }
-  // Connected components of occupied cells (depth-first, explicit stack).
-  slot_label_.assign(m, -1);
+}
+
+void Segmenter::CollectComponent(std::size_t seed, std::int32_t label, Segments* out) {
   static constexpr int kDx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
   static constexpr int kDy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
   const int num_nb = params_.connectivity;
-  std::int32_t label = 0;
-  for (std::size_t seed = 0; seed < m; ++seed) {
-    if (slot_label_[seed] >= 0) continue;
-    const auto begin = static_cast<std::int32_t>(out->point.size());
-    stack_.clear();
-    stack_.push_back(static_cast<std::int32_t>(seed));
-    slot_label_[seed] = label;
-    while (!stack_.empty()) {
-      const auto s = static_cast<std::size_t>(stack_.back());
-      stack_.pop_back();
-      for (std::int32_t k = slot_start_[s]; k < slot_start_[s + 1]; ++k) {
-        out->point.push_back(sorted_[static_cast<std::size_t>(k)]);
-      }
-      const std::int32_t c = occupied_[s];
-      for (int j = 0; j < num_nb; ++j) {
-        const auto nc = static_cast<std::size_t>(c + kDy[j] * side_ + kDx[j]);
-        if (cells_[nc].stamp != generation_) continue;
-        const auto ns = static_cast<std::size_t>(cells_[nc].slot);
-        if (slot_label_[ns] >= 0) continue;
-        slot_label_[ns] = label;
-        stack_.push_back(static_cast<std::int32_t>(ns));
-      }
+  stack_.clear();
+  stack_.push_back(static_cast<std::int32_t>(seed));
+  slot_label_[seed] = label;
+  while (!stack_.empty()) {
+    const auto s = static_cast<std::size_t>(stack_.back());
+    stack_.pop_back();
+    for (std::int32_t k = slot_start_[s]; k < slot_start_[s + 1]; ++k) {
+      out->point.push_back(sorted_[static_cast<std::size_t>(k)]);
     }
-    ++label;
-    Finish(pts, begin, out);
+    const std::int32_t c = occupied_[s];
+    for (int j = 0; j < num_nb; ++j) {
+      const auto nc = static_cast<std::size_t>(c + kDy[j] * side_ + kDx[j]);
+      if (cells_[nc].stamp != generation_) continue;
+      const auto ns = static_cast<std::size_t>(cells_[nc].slot);
+      if (slot_label_[ns] >= 0) continue;
+      slot_label_[ns] = label;
+      stack_.push_back(static_cast<std::int32_t>(ns));
+    }
   }
 }
 

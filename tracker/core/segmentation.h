@@ -64,6 +64,11 @@ class Segmenter {
  private:
   void RunScanLine(const WorldPoints& pts, const Eigen::Vector2d& sensor_xy, Segments* out);
   void RunGrid(const WorldPoints& pts, const Eigen::Vector2d& sensor_xy, Segments* out);
+  // Grid steps: every return's cell slot; the returns sorted by slot; one connected component
+  // of occupied cells from seed, its returns appended to out->point.
+  void BinReturns(const WorldPoints& pts, const Eigen::Vector2d& sensor_xy);
+  void SortReturnsByCell(std::size_t num_points);
+  void CollectComponent(std::size_t seed, std::int32_t label, Segments* out);
   // Appends a segment from out->point[begin, end) if it passes the size filters.
   void Finish(const WorldPoints& pts, std::int32_t begin, Segments* out);
 

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -107,8 +108,9 @@ std::string DefaultBinDir() {
 }
 
 std::string FindKittiCalib(const CompareOptions& o, const CompareItem& item) {
-  if (!o.kitti_calib.empty()) return o.kitti_calib;
-  const std::string seq = kitti::NormaliseSequence(o.kitti_sequence);
+  if (!o.kitti_calib.empty() && item.kind == CompareItem::Kind::kKitti) return o.kitti_calib;
+  const std::string seq = kitti::NormaliseSequence(
+      item.kind == CompareItem::Kind::kKittiBoxes ? item.sequence : o.kitti_sequence);
   for (const fs::path& p : {fs::path(item.source) / "calib" / (seq + ".txt"),
                             fs::path(item.source) / "training" / "calib" / (seq + ".txt")}) {
     if (fs::is_regular_file(p)) return p.string();
@@ -121,7 +123,79 @@ double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
+// The CLEAR MOT counts of every sequence summed (MOTA recomputed from them, MOTP weighted by
+// the matches), and the prediction errors weighted by their samples; the rest is not summed.
+EvalSummary SumOf(const std::vector<const EvalSummary*>& parts) {
+  EvalSummary s;
+  double motp_sum = 0.0;
+  std::vector<double> pred_sum;
+  for (const EvalSummary* p : parts) {
+    s.mode = p->mode;
+    const ClearMotResult& c = p->clear;
+    s.clear.gt_detections += c.gt_detections;
+    s.clear.true_positives += c.true_positives;
+    s.clear.false_positives += c.false_positives;
+    s.clear.false_negatives += c.false_negatives;
+    s.clear.id_switches += c.id_switches;
+    s.clear.fragmentations += c.fragmentations;
+    s.clear.gt_objects += c.gt_objects;
+    s.clear.mostly_tracked += c.mostly_tracked;
+    s.clear.partially_tracked += c.partially_tracked;
+    s.clear.mostly_lost += c.mostly_lost;
+    if (c.true_positives > 0) motp_sum += c.motp_m * static_cast<double>(c.true_positives);
+    s.scans += p->scans;
+    s.scored_tracks += p->scored_tracks;
+    if (s.prediction_error_m.size() < p->prediction_error_m.size()) {
+      s.prediction_error_m.resize(p->prediction_error_m.size(), 0.0);
+      s.prediction_samples.resize(p->prediction_error_m.size(), 0);
+      pred_sum.resize(p->prediction_error_m.size(), 0.0);
+    }
+    for (std::size_t h = 0; h < p->prediction_error_m.size(); ++h) {
+      if (p->prediction_samples[h] > 0) {
+        pred_sum[h] += p->prediction_error_m[h] * static_cast<double>(p->prediction_samples[h]);
+        s.prediction_samples[h] += p->prediction_samples[h];
+      }
+    }
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const auto& c = s.clear;
+  s.clear.mota = c.gt_detections > 0
+                     ? 1.0 - static_cast<double>(c.false_negatives + c.false_positives + c.id_switches) /
+                                 static_cast<double>(c.gt_detections)
+                     : nan;
+  s.clear.motp_m = c.true_positives > 0 ? motp_sum / static_cast<double>(c.true_positives) : nan;
+  for (std::size_t h = 0; h < pred_sum.size(); ++h) {
+    s.prediction_error_m[h] = s.prediction_samples[h] > 0
+                                  ? pred_sum[h] / static_cast<double>(s.prediction_samples[h])
+                                  : nan;
+  }
+  s.hota.hota = s.hota.deta = s.hota.assa = s.hota.loca = nan;
+  s.position_rmse_m = s.heading_rmse_deg = s.heading_flip_fraction = nan;
+  s.speed_rmse_mps = s.yaw_rate_rmse_dps = s.rear_axle_rmse_m = nan;
+  s.nees_mean = s.nees_within_95 = nan;
+  return s;
+}
+
 }  // namespace
+
+std::vector<std::string> BoxesSequences(const std::string& dir) {
+  std::vector<std::string> out;
+  const fs::path labels = fs::path(dir) / "label_02";
+  std::error_code ec;
+  if (fs::is_directory(labels, ec)) {
+    for (const auto& e : fs::directory_iterator(labels, ec)) {
+      if (e.path().extension() != ".txt") continue;
+      const std::string seq = e.path().stem().string();
+      if (fs::is_regular_file(fs::path(dir) / "ego_pose_orbslam3" / (seq + ".txt"))) out.push_back(seq);
+    }
+  }
+  std::sort(out.begin(), out.end());
+  if (out.empty()) {
+    throw std::invalid_argument("no sequence in '" + dir +
+                                "': expected label_02/NNNN.txt with ego_pose_orbslam3/NNNN.txt");
+  }
+  return out;
+}
 
 CompareItem ScenarioItem(const std::string& name_or_path) {
   CompareItem item;
@@ -133,7 +207,9 @@ CompareItem ScenarioItem(const std::string& name_or_path) {
 }
 
 int RunCompare(const CompareOptions& o) {
-  if (o.items.empty()) throw std::invalid_argument("nothing to compare: give --scenarios and/or --kitti");
+  if (o.items.empty()) {
+    throw std::invalid_argument("nothing to compare: give --scenarios, --kitti and/or --kitti-boxes");
+  }
   if (o.modes.empty()) throw std::invalid_argument("--modes is empty");
   for (const auto& m : o.modes) {
     if (m != "ism" && m != "vasm" && m != "mht") {
@@ -205,7 +281,7 @@ int RunCompare(const CompareOptions& o) {
       if (item.kind == CompareItem::Kind::kScenario) {
         argv = {tool("vtrack-sim-log"), "--scenario", item.source, "--out", run, "--seed",
                 std::to_string(o.seed)};
-      } else {
+      } else if (item.kind == CompareItem::Kind::kKitti) {
         argv = {tool("vtrack-kitti2lcm"), "--kitti", item.source, "--sequence", o.kitti_sequence,
                 "--out", run};
         if (!o.kitti_poses.empty()) argv.insert(argv.end(), {"--poses", o.kitti_poses});
@@ -216,6 +292,14 @@ int RunCompare(const CompareOptions& o) {
         kopt.region_range_m = o.kitti_range_m;
         kopt.truth_time_offset = "half-sweep";  // labels are half a sweep after the scan's utime
         params = MakeEvalParams(kopt);
+      } else {
+        argv = {tool("vtrack-kitti2lcm"), "--kitti", item.source, "--sequence", item.sequence,
+                "--out", run};
+        EvalCliOptions kopt = o.eval;
+        kopt.kitti_calib = FindKittiCalib(o, item);
+        kopt.region_camera = true;
+        kopt.region_range_m = o.kitti_range_m;
+        params = MakeEvalParams(kopt);  // no scans: the truth and the boxes share the frame's time
       }
       if (o.reuse && fs::is_regular_file(run)) {
         say(item.name + ": reusing " + run);
@@ -255,6 +339,9 @@ int RunCompare(const CompareOptions& o) {
         } else {
           std::vector<std::string> argv = {tool("vtrack-tracker"), "--input", run, "--output",
                                            tracks, "--mode", mode};
+          if (item.kind == CompareItem::Kind::kKittiBoxes) {
+            argv.insert(argv.end(), {"--input-mode", "boxes"});
+          }
           if (!o.tracker_config.empty()) argv.insert(argv.end(), {"--config", o.tracker_config});
           say(item.name + " / " + mode + ": " + Join(argv));
           const auto t = std::chrono::steady_clock::now();
@@ -284,14 +371,32 @@ int RunCompare(const CompareOptions& o) {
     }
   }
 
-  // The table, in the order given.
+  // The table, in the order given; the boxes sequences summed per mode.
   std::vector<TableRow> rows;
+  std::map<std::string, EvalSummary> box_sums;
+  bool any_boxes = false;
   for (const CompareItem& item : o.items) {
     for (const std::string& mode : o.modes) {
       const auto it = results.find(item.name);
       const EvalSummary* s = nullptr;
       if (it != results.end() && it->second.count(mode)) s = &it->second.at(mode);
       rows.push_back({item.name, mode, s});
+    }
+    any_boxes = any_boxes || item.kind == CompareItem::Kind::kKittiBoxes;
+  }
+  if (any_boxes) {
+    for (const std::string& mode : o.modes) {
+      std::vector<const EvalSummary*> parts;
+      for (const CompareItem& item : o.items) {
+        const auto it = results.find(item.name);
+        if (item.kind == CompareItem::Kind::kKittiBoxes && it != results.end() && it->second.count(mode)) {
+          parts.push_back(&it->second.at(mode));
+        }
+      }
+      if (!parts.empty()) box_sums[mode] = SumOf(parts);
+    }
+    for (const std::string& mode : o.modes) {
+      rows.push_back({"kitti_boxes_sum", mode, box_sums.count(mode) ? &box_sums.at(mode) : nullptr});
     }
   }
   std::cout << ComparisonTable(rows) << std::flush;
@@ -306,6 +411,20 @@ int RunCompare(const CompareOptions& o) {
         w.Key(mode);
         if (it != results.end() && it->second.count(mode)) {
           std::string js = SummaryJson(it->second.at(mode));
+          while (!js.empty() && js.back() == '\n') js.pop_back();
+          w.Raw(js);
+        } else {
+          w.Raw("null");
+        }
+      }
+      w.EndObject();
+    }
+    if (any_boxes) {
+      w.Key("kitti_boxes_sum").BeginObject();
+      for (const std::string& mode : o.modes) {
+        w.Key(mode);
+        if (box_sums.count(mode)) {
+          std::string js = SummaryJson(box_sums.at(mode));
           while (!js.empty() && js.back() == '\n') js.pop_back();
           w.Raw(js);
         } else {

@@ -3,6 +3,9 @@
 // For each item, a log with scans, ego pose and ground truth is made once:
 //   scenario NAME: vtrack-sim-log --scenario NAME --out <work>/<item>/run.lcm --seed N
 //   KITTI DIR:     vtrack-kitti2lcm --kitti DIR --sequence S --out <work>/<item>/run.lcm [--poses F | --oxts F]
+//   KITTI boxes DIR, each sequence S: vtrack-kitti2lcm --kitti DIR --sequence S (the boxes layout:
+//                  DETECTIONS, EGO_POSE, GROUND_TRUTH), tracked with --input-mode boxes; the
+//                  sum over the sequences is a row of its own (CLEAR MOT counts summed)
 // then for each mode M:  vtrack-tracker --input run.lcm --output tracks_M.lcm --mode M [--config F]
 // and the tracks are scored with vtrack_eval (a library call, the same code as vtrack-eval).
 // KITTI items are scored inside camera 2's view (its labelled region) within kitti_range_m.
@@ -17,10 +20,13 @@
 namespace vtrack::eval {
 
 struct CompareItem {
-  enum class Kind { kScenario, kKitti };
+  // kKittiBoxes: a sequence of a folder in the boxes layout (no point clouds), tracked from
+  // its DETECTIONS (vtrack-tracker --input-mode boxes).
+  enum class Kind { kScenario, kKitti, kKittiBoxes };
   Kind kind = Kind::kScenario;
-  std::string name;    // [-] key in the table and the JSON: scenario name, or kitti_<sequence>
-  std::string source;  // [-] scenario NAME or path; KITTI directory
+  std::string name;      // [-] key in the table and the JSON: scenario name, or kitti_<sequence>
+  std::string source;    // [-] scenario NAME or path; KITTI directory
+  std::string sequence;  // [-] kKittiBoxes: its sequence
 };
 
 struct CompareOptions {
@@ -44,6 +50,10 @@ struct CompareOptions {
 
 // Scenario item from a NAME or path ("urban_intersection", "config/scenarios/x.yaml").
 CompareItem ScenarioItem(const std::string& name_or_path);
+
+// The sequences of a boxes-layout folder: every DIR/label_02/NNNN.txt that has its
+// ego_pose_orbslam3/NNNN.txt, in order. Throws std::invalid_argument if there is none.
+std::vector<std::string> BoxesSequences(const std::string& dir);
 
 // Runs everything, prints progress to stderr and the table to stdout. Returns the exit status:
 // 0 if every (item, mode) was scored, 1 otherwise. Throws std::invalid_argument for bad options.

@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   CompareOptions o;
   std::string scenarios, modes = "ism,vasm,mht";
   std::vector<std::string> kitti_dirs;
+  std::string kitti_boxes_dir, sequences;
 
   po::options_description desc(
       "vtrack-compare --scenarios a,b [--kitti DIR] [options]\n"
@@ -40,6 +41,12 @@ int main(int argc, char** argv) {
     ("kitti", po::value(&kitti_dirs), "KITTI tracking directory (repeatable); scored in camera 2's "
                                       "view within --kitti-range, named kitti_<sequence>")
     ("kitti-sequence", po::value(&o.kitti_sequence)->default_value(o.kitti_sequence), "KITTI sequence")
+    ("kitti-boxes", po::value(&kitti_boxes_dir),
+     "KITTI folder of the boxes layout (label_02/, calib/, detections/pointrcnn_Car/,\n"
+     "ego_pose_orbslam3/; no point clouds): every --sequences tracked from its detections\n"
+     "(--input-mode boxes), named kitti_boxes_<sequence>, and their sum kitti_boxes_sum")
+    ("sequences", po::value(&sequences),
+     "with --kitti-boxes: comma-separated sequences (default: every one the folder holds)")
     ("kitti-poses", po::value(&o.kitti_poses), "ego motion file for the converter (--poses)")
     ("kitti-oxts", po::value(&o.kitti_oxts), "OXTS file for the converter (--oxts)")
     ("kitti-range", po::value(&o.kitti_range_m)->default_value(o.kitti_range_m),
@@ -83,6 +90,25 @@ int main(int argc, char** argv) {
       item.source = d;
       item.name = "kitti_" + o.kitti_sequence;
       o.items.push_back(item);
+    }
+    if (!sequences.empty() && kitti_boxes_dir.empty()) {
+      throw std::invalid_argument("--sequences goes with --kitti-boxes");
+    }
+    if (!kitti_boxes_dir.empty()) {
+      const std::vector<std::string> seqs =
+          sequences.empty() ? vtrack::eval::BoxesSequences(kitti_boxes_dir) : SplitList(sequences);
+      for (const auto& s : seqs) {
+        CompareItem item;
+        item.kind = CompareItem::Kind::kKittiBoxes;
+        item.source = kitti_boxes_dir;
+        try {
+          item.sequence = vtrack::kitti::NormaliseSequence(s);
+        } catch (const std::exception& e) {
+          throw std::invalid_argument(std::string("--sequences: ") + e.what());
+        }
+        item.name = "kitti_boxes_" + item.sequence;
+        o.items.push_back(item);
+      }
     }
     o.modes = SplitList(modes);
     return RunCompare(o);

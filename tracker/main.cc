@@ -51,10 +51,12 @@ class LiveHandler {
   TrackerNode* node_;
 };
 
-int RunLive(const TrackerParams& params, const NodeOptions& options, const std::string& url_in,
+int RunLive(const TrackerParams& params, NodeOptions options, const std::string& url_in,
             double status_period_s) {
   const std::string url = WithReceiveBuffer(url_in);
   auto lcm = lcm_util::OpenLcm(url);
+  // Ids unique across restarts: a consumer must never see an id that meant another vehicle.
+  options.first_track_id = FirstTrackIdAt(lcm_util::WallUtime());
   TrackerNode node(params, options,
                    [&](std::int64_t, const std::string& ch, const void* data, std::size_t size) {
                      lcm->publish(ch, data, static_cast<unsigned int>(size));

@@ -14,7 +14,9 @@ TrackerNode::TrackerNode(const TrackerParams& params, NodeOptions options, Publi
     : params_(params),
       options_(std::move(options)),
       publish_(std::move(publish)),
-      tracker_(params, options_.debug) {}
+      tracker_(params, options_.debug) {
+  tracker_.SetFirstTrackId(options_.first_track_id);
+}
 
 void TrackerNode::Handle(const std::string& channel, const void* data, std::size_t size) {
   // An LCM callback must never let an exception escape: anything unexpected is counted.

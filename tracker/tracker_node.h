@@ -27,6 +27,9 @@ struct NodeOptions {
   std::string debug_channel = "TRACK_DEBUG";
   std::string status_channel = "TRACKER_STATUS";
   bool debug = false;  // publish TRACK_DEBUG
+  // The first track id. Offline: 1 (reruns identical). Live: FirstTrackIdAt(wall clock), so
+  // that a restarted tracker never reuses an id that meant another vehicle before.
+  std::int64_t first_track_id = 1;
 };
 
 class TrackerNode {

@@ -61,27 +61,43 @@ void ScanSequencer::Reset(const std::string& why) {
   rejects_->Event("reset", "tracker reset: " + why);
 }
 
-bool ScanSequencer::CheckTime(std::int64_t utime, const char* what) {
-  if (have_time_ && utime < latest_utime_ - params_.time_jump_reset_us) {
-    Reset(std::string(what) + " time jumped back by " +
-          Str((latest_utime_ - utime) / 1000) + " ms (looped log?)");
+ScanSequencer::TimeCheck ScanSequencer::CheckTime(std::int64_t utime, const char* what) {
+  if (!have_time_) {
     latest_utime_ = utime;
     have_time_ = true;
-    return true;
+    return TimeCheck::kOk;
   }
+  // In 128 bits: a stamp near INT64_MIN or INT64_MAX must not overflow the difference.
+  const __int128 d = static_cast<__int128>(utime) - static_cast<__int128>(latest_utime_);
   // A jump forward longer than any track may coast (a clock step, a log that skips ahead): no
   // track can survive it, and predicting them across it would only let stale tracks (with huge
-  // covariances) catch the new returns.
+  // covariances) catch the new returns. A jump back: a looped log.
   const std::int64_t forward_us = std::max(params_.time_jump_reset_us, max_coast_us_);
-  if (have_time_ && utime > latest_utime_ + forward_us) {
-    Reset(std::string(what) + " time jumped forward by " + Str((utime - latest_utime_) / 1000) + " ms");
+  const bool back = d < -static_cast<__int128>(params_.time_jump_reset_us);
+  const bool forward = d > static_cast<__int128>(forward_us);
+  if (!back && !forward) {
+    jump_pending_ = false;
+    if (utime > latest_utime_) latest_utime_ = utime;
+    return TimeCheck::kOk;
+  }
+  const std::string how = std::string(what) + " time jumped " + (back ? "back" : "forward") + " by " +
+                          Str(static_cast<std::int64_t>((back ? -d : d) / 1000)) + " ms";
+  // One message alone (a stray datagram, a bad stamp) must not wipe every track: the jump is
+  // believed when the next message lies within time_jump_reset_us of it.
+  const __int128 from_pending = static_cast<__int128>(utime) - static_cast<__int128>(pending_utime_);
+  if (jump_pending_ && from_pending <= params_.time_jump_reset_us &&
+      from_pending >= -static_cast<__int128>(params_.time_jump_reset_us)) {
+    Reset(how + (back ? " (looped log?), confirmed by the next message" : ", confirmed by the next message"));
+    jump_pending_ = false;
     latest_utime_ = utime;
     have_time_ = true;
-    return true;
+    return TimeCheck::kReset;
   }
-  if (!have_time_ || utime > latest_utime_) latest_utime_ = utime;
-  have_time_ = true;
-  return false;
+  jump_pending_ = true;
+  pending_utime_ = utime;
+  rejects_->Count("time_jump_unconfirmed", 1,
+                  how + ": refused (believed only if the next message confirms it)");
+  return TimeCheck::kOutlier;
 }
 
 ScanSequencer::Admission ScanSequencer::AddPose(const EgoPose& pose) {
@@ -92,7 +108,9 @@ ScanSequencer::Admission ScanSequencer::AddPose(const EgoPose& pose) {
                     "pose at " + Str(pose.utime) + " is not finite or not a rotation");
     return a;
   }
-  a.reset = CheckTime(pose.utime, "pose");
+  const TimeCheck tc = CheckTime(pose.utime, "pose");
+  if (tc == TimeCheck::kOutlier) return a;
+  a.reset = tc == TimeCheck::kReset;
   switch (poses_.Add(pose.utime, pose.world_from_body)) {
     case PoseHistory::AddResult::kOk: break;
     case PoseHistory::AddResult::kDuplicate:
@@ -156,7 +174,12 @@ ScanSequencer::Admission ScanSequencer::AddScan(LadarScan&& scan) {
   };
   const char* reason = "";
   if (const std::string why = CheckScan(scan, &reason); !why.empty()) return drop(reason, why);
-  a.reset = CheckTime(scan.utime, "scan");
+  const TimeCheck tc = CheckTime(scan.utime, "scan");
+  if (tc == TimeCheck::kOutlier) {
+    ++scans_dropped_;
+    return a;
+  }
+  a.reset = tc == TimeCheck::kReset;
   if (have_scan_ && scan.utime <= last_scan_utime_) {
     return drop(scan.utime == last_scan_utime_ ? "scan_repeated" : "scan_out_of_order",
                 "not after the previous scan at " + Str(last_scan_utime_));
@@ -186,7 +209,9 @@ ScanSequencer::Admission ScanSequencer::AddDetections(DetectionList&& list) {
       return a;
     }
   }
-  a.reset = CheckTime(list.utime, "detections");
+  const TimeCheck tc = CheckTime(list.utime, "detections");
+  if (tc == TimeCheck::kOutlier) return a;
+  a.reset = tc == TimeCheck::kReset;
   if (have_detections_ && list.utime <= last_detections_utime_) {
     rejects_->Count(list.utime == last_detections_utime_ ? "detections_repeated" : "detections_out_of_order",
                     1, "detections at " + Str(list.utime) + " not after the previous ones at " +

@@ -7,8 +7,10 @@
 // Bad input is refused and counted by reason (RejectCounter): malformed scans and poses, scans
 // out of time order or repeated, scans lost on the way (gaps in the sensor's seq), a full
 // queue. A message more than time_jump_reset_us older than the newest one (a looped log), or
-// newer than the newest by more than any track may coast, resets the input: queue and poses are
-// cleared, and the caller clears its tracks.
+// newer than the newest by more than any track may coast, is refused ("time_jump_unconfirmed")
+// unless the message before it made the same jump: two in a row reset the input (queue and
+// poses cleared, the caller clears its tracks) and the second is taken. One stray message
+// cannot wipe the tracks.
 #pragma once
 
 #include <cstdint>
@@ -89,8 +91,10 @@ class ScanSequencer {
   void CountSeqGap(std::int64_t seq);
   // "" if the scan is well formed, else why not (its reject reason in *reason).
   std::string CheckScan(const LadarScan& scan, const char** reason) const;
-  // Follows the newest message time; true if utime jumped and the input was reset.
-  bool CheckTime(std::int64_t utime, const char* what);
+  // Follows the newest message time: kOk, kReset (a jump confirmed: the input was reset), or
+  // kOutlier (an unconfirmed jump: the message is refused, counted).
+  enum class TimeCheck { kOk, kReset, kOutlier };
+  TimeCheck CheckTime(std::int64_t utime, const char* what);
   void Reset(const std::string& why);
 
   InputParams params_;
@@ -105,6 +109,8 @@ class ScanSequencer {
   std::int64_t detections_received_ = 0, detections_processed_ = 0;
   std::int64_t latest_utime_ = 0;
   bool have_time_ = false;
+  bool jump_pending_ = false;       // the previous message jumped (refused, unconfirmed)
+  std::int64_t pending_utime_ = 0;  // [us] its time
   std::int64_t last_scan_utime_ = 0;
   bool have_scan_ = false;
   std::int64_t last_seq_ = 0;  // newest scan seq received (for scan_seq_gap)

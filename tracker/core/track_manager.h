@@ -112,6 +112,9 @@ class TrackManager {
   void Report(std::int64_t utime, std::vector<TrackReport>* out) const;
 
   void Clear() { tracks_.clear(); }  // ids continue: never reused within a run
+  // The id of the next track (>= 1; ids then count up from it). A process that restarts gives
+  // a larger one than any id it gave before (the live tracker: from the wall clock).
+  void SetNextId(std::int64_t id) { next_id_ = id; }
   const std::vector<Track>& tracks() const { return tracks_; }
   const TrackManagerParams& params() const { return params_; }
 

@@ -83,6 +83,16 @@ Tracker::Tracker(const TrackerParams& params, bool debug)
   manager_ = std::make_unique<TrackManager>(params_.manager, *ekf_, params_.fit, params_.shape);
 }
 
+std::int64_t FirstTrackIdAt(std::int64_t wall_utime) {
+  constexpr std::int64_t kIdsPerMs = 100'000;
+  return wall_utime > 0 ? (wall_utime / 1000) * kIdsPerMs + 1 : 1;
+}
+
+void Tracker::SetFirstTrackId(std::int64_t id) {
+  if (id < 1) throw std::invalid_argument("first track id " + Str(id) + " must be >= 1");
+  manager_->SetNextId(id);
+}
+
 void Tracker::AddPose(const EgoPose& pose, std::vector<ScanOutput>* out) {
   const ScanSequencer::Admission a = sequencer_.AddPose(pose);
   if (a.reset) manager_->Clear();

@@ -45,6 +45,12 @@ struct ScanOutput {
   PreprocessStats stats;
 };
 
+// A first track id larger than every id of a tracker started earlier (for a process that may be
+// restarted): the start time in milliseconds times 100000, plus 1 (a tracker would have to
+// create 100000 tracks per millisecond it ran to reach the next start's range). 1 for times at
+// or before the epoch.
+std::int64_t FirstTrackIdAt(std::int64_t wall_utime);
+
 class Tracker {
  public:
   // Throws std::invalid_argument naming the first invalid parameter.
@@ -68,6 +74,9 @@ class Tracker {
   std::size_t queued_scans() const { return sequencer_.queued_scans(); }
   // Events since the last call (for rate-limited warnings).
   std::vector<TrackerEvent> TakeEvents() { return rejects_.TakeEvents(); }
+
+  // The id of the next track (see TrackManager::SetNextId). Throws std::invalid_argument if < 1.
+  void SetFirstTrackId(std::int64_t id);
 
   const TrackManager& manager() const { return *manager_; }
   const TrackerParams& params() const { return params_; }

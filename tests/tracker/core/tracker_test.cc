@@ -260,6 +260,82 @@ TEST(TrackerTest, SurvivesEveryBadInputAndCountsIt) {
                 static_cast<std::int64_t>(tracker.queued_scans()));
 }
 
+// One stray message stamped 1 h ahead, then one 5 s behind, amid a steady stream: neither resets
+// the tracker (each is refused and counted), the tracks keep their ids. Two messages in a row
+// 1 h ahead (a real clock step) reset it. A stamp near INT64_MIN is a jump back, said with a
+// positive number of milliseconds (no overflow in the difference).
+TEST(TrackerTest, OneMessageOutOfTimeDoesNotResetTwoInARowDo) {
+  SyntheticScene scene(SceneConfig{}, TwoCars(), 5);
+  Tracker tracker(TrackerParams{});
+  std::vector<ScanOutput> out;
+  std::int64_t seq = 0;
+  auto run = [&](double from_s, double to_s) {
+    for (int tick = static_cast<int>(from_s * 100); tick <= static_cast<int>(to_s * 100); ++tick) {
+      const double t = tick * 0.01;
+      tracker.AddPose(scene.PoseAt(t), &out);
+      if (tick >= 10 && tick % 10 == 0) tracker.AddScan(scene.ScanAt(t - 0.1, seq++), &out);
+    }
+  };
+  run(0.0, 2.0);
+  auto confirmed_ids = [&] {
+    std::set<std::int64_t> ids;
+    for (const auto& r : out.back().tracks) {
+      if (r.status == TrackStatus::kConfirmed) ids.insert(r.id);
+    }
+    return ids;
+  };
+  const std::set<std::int64_t> before = confirmed_ids();
+  ASSERT_EQ(before.size(), 2u);
+  EgoPose ahead = scene.PoseAt(2.005);
+  ahead.utime += 3'600'000'000;  // 1 h ahead
+  tracker.AddPose(ahead, &out);
+  tracker.AddScan(scene.ScanAt(-3.0, seq++), &out);  // 5 s behind the newest message
+  run(2.01, 3.0);
+  EXPECT_EQ(tracker.resets(), 0);
+  EXPECT_EQ(tracker.rejects().at("time_jump_unconfirmed"), 2);
+  EXPECT_EQ(confirmed_ids(), before);
+  EXPECT_EQ(tracker.scans_received(),
+            tracker.scans_processed() + tracker.scans_dropped() +
+                static_cast<std::int64_t>(tracker.queued_scans()));
+  // A stamp at INT64_MIN: refused, and the message says how far back in positive milliseconds.
+  tracker.TakeEvents();
+  EgoPose bottom = scene.PoseAt(3.005);
+  bottom.utime = std::numeric_limits<std::int64_t>::min();
+  tracker.AddPose(bottom, &out);
+  bool said = false;
+  for (const auto& e : tracker.TakeEvents()) {
+    if (e.reason != "time_jump_unconfirmed") continue;
+    said = true;
+    EXPECT_EQ(e.message.find("by -"), std::string::npos) << e.message;
+  }
+  EXPECT_TRUE(said);
+  EXPECT_EQ(tracker.resets(), 0);
+  // Two poses in a row 1 h ahead: believed.
+  for (double t : {3.01, 3.02}) {
+    EgoPose p = scene.PoseAt(t);
+    p.utime += 3'600'000'000;
+    tracker.AddPose(p, &out);
+  }
+  EXPECT_EQ(tracker.resets(), 1);
+}
+
+TEST(TrackerTest, FirstTrackIdsOfLaterStartsLieAboveEveryEarlierId) {
+  const std::int64_t t1 = 1'700'000'000'000'000;  // [us]
+  // A tracker started 1 ms later starts 100000 ids higher: more than it could give in 1 ms.
+  EXPECT_GE(FirstTrackIdAt(t1 + 1000) - FirstTrackIdAt(t1), 100'000);
+  EXPECT_GE(FirstTrackIdAt(t1), 1);
+  EXPECT_EQ(FirstTrackIdAt(-5), 1);
+  // The tracker takes it: its first track carries that id.
+  SyntheticScene scene(SceneConfig{}, TwoCars(), 5);
+  Tracker tracker(TrackerParams{});
+  tracker.SetFirstTrackId(FirstTrackIdAt(t1));
+  EXPECT_THROW(tracker.SetFirstTrackId(0), std::invalid_argument);
+  const std::vector<ScanOutput> outs = RunScene(&tracker, &scene, 1.0);
+  std::int64_t min_id = std::numeric_limits<std::int64_t>::max();
+  for (const auto& o : outs) for (const auto& r : o.tracks) min_id = std::min(min_id, r.id);
+  EXPECT_EQ(min_id, FirstTrackIdAt(t1));
+}
+
 TEST(TrackerTest, InvalidParamsNameTheKey) {
   TrackerParams p;
   p.manager.max_hypotheses = 7;

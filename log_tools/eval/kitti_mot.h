@@ -64,6 +64,8 @@
 //     that were not reached count 0). The reported MOTA, MOTP, IDS, FRAG, FP, FN are those at
 //     the threshold of the best MOTA (the first best, and only if > 0; else every track).
 //     Over several sequences, counts and matched scores are pooled before any ratio is taken.
+//     Without non-ignored ground truth MOTA and sMOTA are undefined (NaN; the reference gives
+//     -inf) and add nothing to the sums.
 //  Each threshold is evaluated from scratch (the reference script keeps a per-box "matched"
 //  flag from earlier runs of its sweep, which can change rule 7 for a box that was matched at
 //  another threshold; rare, and not reproduced).

@@ -49,7 +49,11 @@ std::vector<std::string> ParseSequences(const std::string& text) {
 std::vector<std::string> ListSequences(const std::string& dir) {
   std::vector<std::string> out;
   for (const auto& e : fs::directory_iterator(dir)) {
-    if (e.is_regular_file() && e.path().extension() == ".txt") out.push_back(e.path().stem());
+    const std::string stem = e.path().stem().string();
+    if (e.is_regular_file() && e.path().extension() == ".txt" && !stem.empty() &&
+        std::all_of(stem.begin(), stem.end(), [](unsigned char c) { return std::isdigit(c); })) {
+      out.push_back(stem);
+    }
   }
   std::sort(out.begin(), out.end());
   return out;

@@ -482,6 +482,10 @@ TEST_F(KittiMotCliTest, HandCaseThroughTheCommand) {
       << out;
   EXPECT_EQ(out.find("[1/1]"), std::string::npos) << out;  // -q
   EXPECT_NEAR(YAML::LoadFile(dir_ + "/m7.json")["all"]["mota"].as<double>(), 1.0 / 6.0, 1e-6);
+  // Without --sequences: every NNNN.txt in --labels, nothing else.
+  WriteFile(dir_ + "/labels/notes.txt", "not a sequence\n");
+  EXPECT_EQ(Run({"--labels", dir_ + "/labels", "--results", dir_ + "/results"}, &out), 0) << out;
+  EXPECT_NE(out.find("[1/1] 0000"), std::string::npos) << out;
 }
 
 TEST_F(KittiMotCliTest, HelpAndErrors) {

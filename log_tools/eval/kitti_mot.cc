@@ -109,6 +109,50 @@ double OverlapOverFirst(const KittiObject& a, const KittiObject& b) {
   return area > 0.0 ? w * h / area : 0.0;
 }
 
+// Rule 9 for one ground-truth trajectory: (matched tracker id or -1, ignored) per appearance.
+// The devkit's loop, literally.
+void CountTrajectory(const std::vector<std::pair<std::int64_t, bool>>& entries, Counts* c) {
+  const std::size_t n = entries.size();
+  auto id = [&](std::size_t k) { return entries[k].first; };
+  auto ign = [&](std::size_t k) { return entries[k].second; };
+  std::size_t n_ignored = 0;
+  for (std::size_t k = 0; k < n; ++k) n_ignored += ign(k) ? 1 : 0;
+  if (n == 0 || n_ignored == n) return;  // ignored throughout
+  ++c->gt_trajectories;
+  bool any = false;
+  for (std::size_t k = 0; k < n; ++k) any = any || id(k) != -1;
+  if (!any) {
+    ++c->mostly_lost;
+    return;
+  }
+  std::int64_t last = id(0);
+  std::int64_t tracked = id(0) >= 0 ? 1 : 0;
+  for (std::size_t f = 1; f < n; ++f) {
+    if (ign(f)) {
+      last = -1;
+      continue;
+    }
+    if (last != id(f) && last != -1 && id(f) != -1 && id(f - 1) != -1) ++c->ids;
+    if (f < n - 1 && id(f - 1) != id(f) && last != -1 && id(f) != -1 && id(f + 1) != -1) {
+      ++c->frag;
+    }
+    if (id(f) != -1) {
+      ++tracked;
+      last = id(f);
+    }
+  }
+  // The last appearance (the loop above leaves it to this test).
+  if (n > 1 && id(n - 2) != id(n - 1) && last != -1 && id(n - 1) != -1 && !ign(n - 1)) ++c->frag;
+  const double ratio = static_cast<double>(tracked) / static_cast<double>(n - n_ignored);
+  if (ratio > 0.8) {
+    ++c->mostly_tracked;
+  } else if (ratio < 0.2) {
+    ++c->mostly_lost;
+  } else {
+    ++c->partly_tracked;
+  }
+}
+
 }  // namespace
 
 double FootprintIntersection(const Box3d& a, const Box3d& b) {
@@ -429,48 +473,7 @@ Counts PreparedSequence::Evaluate(double threshold, std::vector<double>* matched
   }
   c.gt = c.tp + c.fn;
 
-  // Rule 9, per trajectory (the devkit's loop, literally).
-  for (const auto& [gt_id, entries] : traj) {
-    const std::size_t n = entries.size();
-    auto id = [&](std::size_t k) { return entries[k].first; };
-    auto ign = [&](std::size_t k) { return entries[k].second; };
-    std::size_t n_ignored = 0;
-    for (std::size_t k = 0; k < n; ++k) n_ignored += ign(k) ? 1 : 0;
-    if (n_ignored == n) continue;  // ignored throughout
-    ++c.gt_trajectories;
-    bool any = false;
-    for (std::size_t k = 0; k < n; ++k) any = any || id(k) != -1;
-    if (!any) {
-      ++c.mostly_lost;
-      continue;
-    }
-    std::int64_t last = id(0);
-    std::int64_t tracked = id(0) >= 0 ? 1 : 0;
-    for (std::size_t f = 1; f < n; ++f) {
-      if (ign(f)) {
-        last = -1;
-        continue;
-      }
-      if (last != id(f) && last != -1 && id(f) != -1 && id(f - 1) != -1) ++c.ids;
-      if (f < n - 1 && id(f - 1) != id(f) && last != -1 && id(f) != -1 && id(f + 1) != -1) {
-        ++c.frag;
-      }
-      if (id(f) != -1) {
-        ++tracked;
-        last = id(f);
-      }
-    }
-    // The last appearance (the loop above leaves it to this test).
-    if (n > 1 && id(n - 2) != id(n - 1) && last != -1 && id(n - 1) != -1 && !ign(n - 1)) ++c.frag;
-    const double ratio = static_cast<double>(tracked) / static_cast<double>(n - n_ignored);
-    if (ratio > 0.8) {
-      ++c.mostly_tracked;
-    } else if (ratio < 0.2) {
-      ++c.mostly_lost;
-    } else {
-      ++c.partly_tracked;
-    }
-  }
+  for (const auto& [gt_id, entries] : traj) CountTrajectory(entries, &c);
   return c;
 }
 

@@ -136,12 +136,24 @@ void ResultJson(JsonWriter& j, std::int64_t frames, std::int64_t result_boxes, c
   j.EndObject();
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  std::string labels_dir, results_dir, sequences_text, json_path;
+struct Options {
+  std::string labels_dir, results_dir, json_path;
+  std::vector<std::string> sequences;
   Params params;
   bool quiet = false;
+};
+
+// A scored sequence, or "all" for the pool.
+struct Scored {
+  std::string name;
+  std::int64_t frames = 0, result_boxes = 0;
+  Result result;
+};
+
+// Parses the command line into o. Returns -1 to go on, else the exit status (0 after --help,
+// 2 for a bad option, with the message printed).
+int ParseOptions(int argc, char** argv, Options* o) {
+  std::string sequences_text;
   po::options_description desc(
       "vtrack-eval-kitti --labels DIR --results DIR [--sequences 0000,0002] [options]\n"
       "Scores tracking results in the KITTI format (frame id type truncated occluded alpha x1 y1\n"
@@ -152,16 +164,14 @@ int main(int argc, char** argv) {
       "Table values are percentages; the JSON holds fractions.\n\nOptions");
   desc.add_options()
     ("help,h", "print this help")
-    ("labels", po::value(&labels_dir), "folder of ground-truth label files NNNN.txt (label_02)")
-    ("results", po::value(&results_dir), "folder of result files NNNN.txt")
+    ("labels", po::value(&o->labels_dir), "folder of ground-truth label files NNNN.txt (label_02)")
+    ("results", po::value(&o->results_dir), "folder of result files NNNN.txt")
     ("sequences", po::value(&sequences_text),
      "comma-separated sequences, e.g. 0000,0002 or 0,2 [every NNNN.txt in --labels]")
-    ("iou", po::value(&params.min_iou)->default_value(0.25),
+    ("iou", po::value(&o->params.min_iou)->default_value(0.25),
      "3-D IoU a match needs (0.25, 0.5, 0.7 are the published settings)")
-    ("json", po::value(&json_path), "write per-sequence and summed metrics here")
-    ("quiet,q", po::bool_switch(&quiet), "no progress output");
-
-  std::vector<std::string> sequences;
+    ("json", po::value(&o->json_path), "write per-sequence and summed metrics here")
+    ("quiet,q", po::bool_switch(&o->quiet), "no progress output");
   try {
     po::variables_map vm;
     po::store(po::parse_command_line(argc, argv, desc), vm);
@@ -170,88 +180,105 @@ int main(int argc, char** argv) {
       return 0;
     }
     po::notify(vm);
-    if (labels_dir.empty()) throw std::invalid_argument("--labels DIR is required (see --help)");
-    if (results_dir.empty()) throw std::invalid_argument("--results DIR is required (see --help)");
-    if (!(params.min_iou > 0.0 && params.min_iou <= 1.0)) {
-      throw std::invalid_argument("--iou must be in (0, 1], got " + std::to_string(params.min_iou));
+    if (o->labels_dir.empty()) throw std::invalid_argument("--labels DIR is required (see --help)");
+    if (o->results_dir.empty()) {
+      throw std::invalid_argument("--results DIR is required (see --help)");
     }
-    for (const auto& [opt, dir] : {std::pair{"--labels", labels_dir}, {"--results", results_dir}}) {
+    if (!(o->params.min_iou > 0.0 && o->params.min_iou <= 1.0)) {
+      throw std::invalid_argument("--iou must be in (0, 1], got " +
+                                  std::to_string(o->params.min_iou));
+    }
+    for (const auto& [opt, dir] :
+         {std::pair{"--labels", o->labels_dir}, {"--results", o->results_dir}}) {
       if (!fs::is_directory(dir)) {
         throw std::invalid_argument(std::string(opt) + " " + dir + ": not a directory");
       }
     }
-    sequences = sequences_text.empty() ? ListSequences(labels_dir) : ParseSequences(sequences_text);
-    if (sequences.empty()) throw std::invalid_argument("no sequence to score in " + labels_dir);
+    o->sequences =
+        sequences_text.empty() ? ListSequences(o->labels_dir) : ParseSequences(sequences_text);
+    if (o->sequences.empty()) {
+      throw std::invalid_argument("no sequence to score in " + o->labels_dir);
+    }
   } catch (const std::exception& e) {
     std::cerr << "vtrack-eval-kitti: " << e.what() << "\n";
     return 2;
   }
+  return -1;
+}
 
+void PrintTable(const Params& params, const std::vector<Scored>& rows) {
+  std::printf("KITTI 3-D MOT, class car, 3-D IoU >= %g; sweep over %d recall points; "
+              "percentages\n",
+              params.min_iou, params.sample_points - 1);
+  std::printf("%-8s %6s %7s %7s %7s %7s %9s %7s %7s %6s %6s %6s %6s %5s %5s\n", "sequence",
+              "frames", "gt", "sAMOTA", "AMOTA", "AMOTP", "threshold", "MOTA", "MOTP", "TP",
+              "FP", "FN", "ignGT", "IDS", "FRAG");
+  for (const Scored& r : rows) std::fputs(TableRow(r.name, r.frames, r.result).c_str(), stdout);
+}
+
+// rows: the sequences, then the pool.
+void WriteJson(const Options& o, const std::vector<Scored>& rows) {
+  JsonWriter j;
+  j.BeginObject();
+  j.Key("class").String("car");
+  j.Key("labels").String(o.labels_dir);
+  j.Key("results").String(o.results_dir);
+  j.Key("params").BeginObject();
+  j.Key("min_iou").Number(o.params.min_iou);
+  j.Key("max_truncation").Int(o.params.max_truncation);
+  j.Key("max_occlusion").Int(o.params.max_occlusion);
+  j.Key("min_height_px").Number(o.params.min_height_px);
+  j.Key("dontcare_overlap").Number(o.params.dontcare_overlap);
+  j.Key("recall_points").Int(o.params.sample_points - 1);
+  j.EndObject();
+  j.Key("sequences").BeginObject();
+  for (std::size_t k = 0; k + 1 < rows.size(); ++k) {
+    j.Key(rows[k].name);
+    ResultJson(j, rows[k].frames, rows[k].result_boxes, rows[k].result);
+  }
+  j.EndObject();
+  j.Key("all");
+  ResultJson(j, rows.back().frames, rows.back().result_boxes, rows.back().result);
+  j.EndObject();
+  std::ofstream out(o.json_path);
+  out << j.str() << "\n";
+  if (!out) throw std::runtime_error(o.json_path + ": cannot write");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  if (const int rc = ParseOptions(argc, argv, &o); rc >= 0) return rc;
   try {
     std::vector<std::unique_ptr<PreparedSequence>> prepared;
-    std::vector<Result> results;
-    for (std::size_t k = 0; k < sequences.size(); ++k) {
-      const std::string& name = sequences[k];
-      const auto gt = ReadTrackingFile((fs::path(labels_dir) / (name + ".txt")).string(), false);
-      const auto res = ReadTrackingFile((fs::path(results_dir) / (name + ".txt")).string(), true);
-      prepared.push_back(std::make_unique<PreparedSequence>(name, gt, res, params));
-      results.push_back(Score({prepared.back().get()}, params));
-      if (!quiet) {
+    std::vector<Scored> rows;
+    Scored all;
+    all.name = "all";
+    for (std::size_t k = 0; k < o.sequences.size(); ++k) {
+      const std::string& name = o.sequences[k];
+      const auto gt = ReadTrackingFile((fs::path(o.labels_dir) / (name + ".txt")).string(), false);
+      const auto res = ReadTrackingFile((fs::path(o.results_dir) / (name + ".txt")).string(), true);
+      prepared.push_back(std::make_unique<PreparedSequence>(name, gt, res, o.params));
+      rows.push_back({name, prepared.back()->frames(), prepared.back()->result_boxes(),
+                      Score({prepared.back().get()}, o.params)});
+      all.frames += rows.back().frames;
+      all.result_boxes += rows.back().result_boxes;
+      if (!o.quiet) {
         std::fprintf(stderr,
                      "vtrack-eval-kitti: [%zu/%zu] %s: %lld frames, %zu car/van/DontCare label "
                      "rows, %zu car/van result rows, %zu thresholds\n",
-                     k + 1, sequences.size(), name.c_str(),
-                     static_cast<long long>(prepared.back()->frames()), gt.size(), res.size(),
-                     results.back().sweep.size());
+                     k + 1, o.sequences.size(), name.c_str(),
+                     static_cast<long long>(rows.back().frames), gt.size(), res.size(),
+                     rows.back().result.sweep.size());
       }
     }
     std::vector<const PreparedSequence*> pool;
-    std::int64_t frames = 0, boxes = 0;
-    for (const auto& p : prepared) {
-      pool.push_back(p.get());
-      frames += p->frames();
-      boxes += p->result_boxes();
-    }
-    const Result all = Score(pool, params);
-
-    std::printf("KITTI 3-D MOT, class car, 3-D IoU >= %g; sweep over %d recall points; "
-                "percentages\n",
-                params.min_iou, params.sample_points - 1);
-    std::printf("%-8s %6s %7s %7s %7s %7s %9s %7s %7s %6s %6s %6s %6s %5s %5s\n", "sequence",
-                "frames", "gt", "sAMOTA", "AMOTA", "AMOTP", "threshold", "MOTA", "MOTP", "TP",
-                "FP", "FN", "ignGT", "IDS", "FRAG");
-    for (std::size_t k = 0; k < sequences.size(); ++k) {
-      std::fputs(TableRow(sequences[k], prepared[k]->frames(), results[k]).c_str(), stdout);
-    }
-    std::fputs(TableRow("all", frames, all).c_str(), stdout);
-
-    if (!json_path.empty()) {
-      JsonWriter j;
-      j.BeginObject();
-      j.Key("class").String("car");
-      j.Key("labels").String(labels_dir);
-      j.Key("results").String(results_dir);
-      j.Key("params").BeginObject();
-      j.Key("min_iou").Number(params.min_iou);
-      j.Key("max_truncation").Int(params.max_truncation);
-      j.Key("max_occlusion").Int(params.max_occlusion);
-      j.Key("min_height_px").Number(params.min_height_px);
-      j.Key("dontcare_overlap").Number(params.dontcare_overlap);
-      j.Key("recall_points").Int(params.sample_points - 1);
-      j.EndObject();
-      j.Key("sequences").BeginObject();
-      for (std::size_t k = 0; k < sequences.size(); ++k) {
-        j.Key(sequences[k]);
-        ResultJson(j, prepared[k]->frames(), prepared[k]->result_boxes(), results[k]);
-      }
-      j.EndObject();
-      j.Key("all");
-      ResultJson(j, frames, boxes, all);
-      j.EndObject();
-      std::ofstream out(json_path);
-      out << j.str() << "\n";
-      if (!out) throw std::runtime_error(json_path + ": cannot write");
-    }
+    for (const auto& p : prepared) pool.push_back(p.get());
+    all.result = Score(pool, o.params);
+    rows.push_back(std::move(all));
+    PrintTable(o.params, rows);
+    if (!o.json_path.empty()) WriteJson(o, rows);
   } catch (const std::exception& e) {
     std::cerr << "vtrack-eval-kitti: " << e.what() << "\n";
     return 1;

@@ -354,6 +354,14 @@ int RunCompare(const CompareOptions& o) {
         EvalParams p = params;
         p.mode = mode;
         results[item.name][mode] = Evaluate(data, p);
+        if (item.kind == CompareItem::Kind::kKittiBoxes) {
+          // The tracks in the KITTI result format, for the 3-D IoU criterion (vtrack-eval-kitti).
+          const fs::path kdir = fs::path(work) / ("kitti_results_" + mode);
+          fs::create_directories(kdir);
+          RunProcess({tool("vtrack-eval"), run, tracks, "--mode", mode, "--kitti-calib",
+                      FindKittiCalib(o, item), "--kitti-out", (kdir / (item.sequence + ".txt")).string()},
+                     (dir / ("kitti_export_" + mode + ".log")).string(), o.timeout_s);
+        }
       } catch (const std::exception& e) {
         failures.push_back(item.name + " / " + mode + ": " + e.what());
         std::fprintf(stderr, "vtrack-compare: %s / %s: %s\n", item.name.c_str(), mode.c_str(),
@@ -401,6 +409,37 @@ int RunCompare(const CompareOptions& o) {
   }
   std::cout << ComparisonTable(rows) << std::flush;
 
+  // The boxes sequences under the criterion 3-D MOT papers publish on KITTI (vtrack-eval-kitti:
+  // the devkit's rules, 3-D IoU >= kitti_iou, AB3DMOT's sAMOTA sweep), per mode.
+  std::map<std::string, std::string> iou_json;
+  std::string labels_dir, seq_list;
+  for (const CompareItem& item : o.items) {
+    if (item.kind != CompareItem::Kind::kKittiBoxes) continue;
+    labels_dir = (fs::path(item.source) / "label_02").string();
+    seq_list += (seq_list.empty() ? "" : ",") + item.sequence;
+  }
+  for (const std::string& mode : o.modes) {
+    if (seq_list.empty() || lcm_util::StopRequested()) break;
+    const fs::path kdir = fs::path(work) / ("kitti_results_" + mode);
+    const fs::path json = fs::path(work) / ("kitti_iou_" + mode + ".json");
+    const fs::path log = fs::path(work) / ("kitti_iou_" + mode + ".log");
+    try {
+      RunProcess({tool("vtrack-eval-kitti"), "--labels", labels_dir, "--results", kdir.string(),
+                  "--sequences", seq_list, "--iou", std::to_string(o.kitti_iou), "--json",
+                  json.string(), "-q"},
+                 log.string(), o.timeout_s);
+      std::ifstream in(log);
+      std::cout << "\n3-D IoU >= " << o.kitti_iou << ", mode " << mode << " (vtrack-eval-kitti):\n"
+                << in.rdbuf() << std::flush;
+      std::ifstream js(json);
+      std::stringstream ss;
+      ss << js.rdbuf();
+      iou_json[mode] = ss.str();
+    } catch (const std::exception& e) {
+      failures.push_back("kitti 3-D IoU / " + mode + ": " + e.what());
+    }
+  }
+
   if (!o.json_path.empty()) {
     JsonWriter w;
     w.BeginObject();
@@ -416,6 +455,15 @@ int RunCompare(const CompareOptions& o) {
         } else {
           w.Raw("null");
         }
+      }
+      w.EndObject();
+    }
+    if (!iou_json.empty()) {
+      w.Key("kitti_boxes_iou").BeginObject();
+      for (const auto& [mode, js] : iou_json) {
+        std::string t = js;
+        while (!t.empty() && (t.back() == '\n' || t.back() == ' ')) t.pop_back();
+        w.Key(mode).Raw(t);
       }
       w.EndObject();
     }

@@ -44,6 +44,7 @@ struct CompareOptions {
   std::string kitti_sequence = "0000";
   std::string kitti_poses, kitti_oxts, kitti_calib;  // [-] "" = the converter's / DIR's default
   double kitti_range_m = 40.0;        // [m] KITTI scoring range; > 0
+  double kitti_iou = 0.25;            // [-] --kitti-boxes: 3-D IoU threshold of vtrack-eval-kitti
   EvalCliOptions eval;                // scoring options for the scenarios
   bool quiet = false;
 };

@@ -45,6 +45,8 @@ int main(int argc, char** argv) {
      "KITTI folder of the boxes layout (label_02/, calib/, detections/pointrcnn_Car/,\n"
      "ego_pose_orbslam3/; no point clouds): every --sequences tracked from its detections\n"
      "(--input-mode boxes), named kitti_boxes_<sequence>, and their sum kitti_boxes_sum")
+    ("kitti-iou", po::value(&o.kitti_iou)->default_value(o.kitti_iou),
+     "with --kitti-boxes: the 3-D IoU threshold of the KITTI criterion (vtrack-eval-kitti)")
     ("sequences", po::value(&sequences),
      "with --kitti-boxes: comma-separated sequences (default: every one the folder holds)")
     ("kitti-poses", po::value(&o.kitti_poses), "ego motion file for the converter (--poses)")

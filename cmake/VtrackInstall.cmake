@@ -31,7 +31,7 @@ install(FILES ${CMAKE_CURRENT_BINARY_DIR}/vtrackConfig.cmake
   ${CMAKE_CURRENT_BINARY_DIR}/vtrackConfigVersion.cmake
   DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/vtrack)
 
-# systemd unit templates and their environment file (deploy/, issue 8): share/vtrack/systemd.
+# systemd unit templates and their environment file (deploy/README.md): share/vtrack/systemd.
 # The units are configured at install time, so that their paths follow the prefix actually used
 # (`cmake --install build --prefix P`); component `systemd` installs them alone.
 find_program(LCM_LOGGER_EXECUTABLE lcm-logger)

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs the tracker benchmarks of issue 9 and prints one table; writes the figures as JSON.
+# Runs the tracker benchmarks (docs/design.md, section 9) and prints one table; writes the figures as JSON.
 #
 #   scripts/bench.sh BUILD_DIR [--json F] [--all] [--soak-minutes M] [--e2e-scans N] [--report-only]
 #

@@ -21,7 +21,7 @@
 
 namespace vtrack::viewer {
 
-// The URL with recv_buf_size=4194304 added for a udpm:// URL that sets none (DESIGN section 8:
+// The URL with recv_buf_size=4194304 added for a udpm:// URL that sets none (docs/design.md, section 8:
 // without a large socket buffer most 2 MB scans are lost). "" means $LCM_DEFAULT_URL, or LCM's
 // default udpm://239.255.76.67:7667?ttl=0. Other providers (memq://, file://) are unchanged.
 std::string WithReceiveBuffer(const std::string& url);

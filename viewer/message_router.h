@@ -13,7 +13,7 @@
 
 namespace vtrack::viewer {
 
-// Channel names (DESIGN section 1); each is a command-line option of vtrack-render.
+// Channel names (docs/design.md, section 1); each is a command-line option of vtrack-render.
 struct Channels {
   std::string scan = "LADAR_SCAN";
   std::string pose = "EGO_POSE";

@@ -1,4 +1,4 @@
-// vtrack-eval LOG... : scores a tracker run against ground truth (DESIGN section 7).
+// vtrack-eval LOG... : scores a tracker run against ground truth (docs/design.md, section 7).
 // See log_tools/README.md for the metrics and the outputs.
 #include <boost/program_options.hpp>
 

@@ -1,4 +1,4 @@
-// Scoring of a tracker run against ground truth, from LCM logs (DESIGN section 7).
+// Scoring of a tracker run against ground truth, from LCM logs (docs/design.md, section 7).
 //
 // Input: one or more LCM logs (e.g. the simulator's run.lcm and the tracker's tracks.lcm) that
 // together hold GROUND_TRUTH (object_list_t), TRACKS (track_list_t) and, for the scoring region

@@ -29,7 +29,7 @@ constexpr const char* kLcmDefaultUrl = "udpm://239.255.76.67:7667?ttl=0";  // LC
 constexpr const char* kRecvBuf = "recv_buf_size=4194304";
 
 // The URL to open: as given, else $LCM_DEFAULT_URL, else LCM's default; a udpm:// URL without
-// recv_buf_size gets one (DESIGN section 8: 2 MB scans are lost with the default socket buffer).
+// recv_buf_size gets one (docs/design.md, section 8: 2 MB scans are lost with the default socket buffer).
 std::string LiveUrl(const std::string& given) {
   std::string url = given;
   if (url.empty()) {

@@ -2,7 +2,7 @@
 //
 // Each reader parses one file strictly: a malformed file throws KittiError with a message that
 // names the file, the line (1-based) and the offending value, never a crash and never a silent
-// guess. Conventions follow the KITTI devkits; frames are named as in DESIGN.md:
+// guess. Conventions follow the KITTI devkits; frames are named as in docs/design.md:
 //   velo  Velodyne HDL-64E frame: x forward, y left, z up (sensor ~1.73 m above the road)
 //   cam   camera 0 frame (unrectified): x right, y down, z forward
 //   rect  rectified camera frame (the frame of the labels): x right, y down, z forward

@@ -1,4 +1,4 @@
-// A scanning LADAR ray-cast against the simulated scene (DESIGN section 5).
+// A scanning LADAR ray-cast against the simulated scene (docs/design.md, section 5).
 //
 // Model. The sensor's head (or mirror) turns at rate_hz revolutions per second and fires one
 // column of rays (one per layer elevation) every resolution_deg of azimuth, starting at
@@ -12,7 +12,7 @@
 // is skewed exactly as a real one. Returns are in the sensor frame at the firing time:
 // x forward, y left, z up; point = range * unit ray direction.
 //
-// Geometry. The ground is the plane z = 0; every object is a vertical prism on it (DESIGN: 2-D
+// Geometry. The ground is the plane z = 0; every object is a vertical prism on it (2-D
 // footprints extruded to their heights): a box or a cylinder. A ray hits a prism where its
 // horizontal path is inside the footprint and its height is within [0, height] (walls and roofs
 // alike). Each column is cast once in 2-D against its candidate footprints and the result shared

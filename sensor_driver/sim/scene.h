@@ -1,4 +1,4 @@
-// The simulated world (DESIGN section 5): vehicles that drive (Ackerman or skid-steer), parked
+// The simulated world (docs/design.md, section 5): vehicles that drive (Ackerman or skid-steer), parked
 // vehicles, clutter (walls, poles, bushes) standing on a flat ground plane z = 0, and the ego
 // vehicle that carries the sensor.
 //

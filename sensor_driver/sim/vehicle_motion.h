@@ -1,4 +1,4 @@
-// True planar kinematics of a simulated vehicle (DESIGN section 5; the motion that the paper's
+// True planar kinematics of a simulated vehicle (docs/design.md, section 5; the motion that the paper's
 // VASM, Section 2.2, models).
 //
 // The rotation axis point A lies on the vehicle's centreline, L = rotation_axis_offset metres

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The systemd units of deploy/ (issue 8), as `cmake --install` writes them: installed into a
+# The systemd units of deploy/, as `cmake --install` writes them: installed into a
 # scratch prefix (component `systemd`), every template variable filled in with that prefix, one
 # unit per process, each restarted on failure and reading the LCM URL from /etc/vtrack/vtrack.env,
 # whose URL has ttl=1. Each command line, with the environment file's values expanded as systemd

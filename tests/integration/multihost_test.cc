@@ -1,4 +1,4 @@
-// Deployment on three hosts (issue 8): three network namespaces joined by a bridge stand for the
+// Deployment on three hosts (deploy/README.md): three network namespaces joined by a bridge stand for the
 // vehicle's computers, with LCM multicast at ttl=1 between them.
 //   sensor host  10.213.0.1: vtrack-ladar-driver + vtrack-ego-pose (paper_fig4_turn, single plane)
 //   compute host 10.213.0.2: vtrack-tracker

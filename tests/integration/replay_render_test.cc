@@ -1,4 +1,4 @@
-// Replay (issue 8), the renderer's side: lcm-logplayer plays a recorded log into a live tracker
+// Replay (deploy/README.md), the renderer's side: lcm-logplayer plays a recorded log into a live tracker
 // and a live renderer (udpm:// inside the private network namespace ctest gives this test), and
 // the frames drawn live are the frames of the offline run (vtrack-tracker --input, then
 // vtrack-render --input over both logs): every TRACKS message of the run gives a frame or a

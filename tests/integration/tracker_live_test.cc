@@ -181,7 +181,7 @@ TEST(TrackerLiveTest, UrbanIntersectionLiveWith64LayerScans) {
     std::printf("\n");
   }
   for (const auto& m : r.switches) std::printf("  switch %s\n", m.c_str());
-  // Issue 5: every due vehicle tracked, no identity switch (measured: 2160 of 2160 pairs, no
+  // The integration criterion: every due vehicle tracked, no identity switch (measured: 2160 of 2160 pairs, no
   // switch, every scan processed; tracker_eval.h says when a vehicle is due). Asserted when every
   // scan reached the tracker; a scan lost on the bus may cost a few pairs: then 99.0% and at
   // most one switch.

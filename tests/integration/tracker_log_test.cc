@@ -1,6 +1,6 @@
 // vtrack-tracker over log files (the real executables): tracking quality on simulated scenarios
 // against their ground truth, identical output when a log is processed twice, the hypothesis
-// counts of the multi-hypothesis manager, and every bad input of DESIGN section 9 counted in
+// counts of the multi-hypothesis manager, and every bad input of docs/design.md, section 9 counted in
 // TRACKER_STATUS.
 #include <gtest/gtest.h>
 
@@ -139,7 +139,7 @@ TEST_F(TrackerLogTest, UrbanIntersectionStationaryObjectsHoldOneHypothesisMovers
   // hypothesis (no parked car is judged a mover).
   EXPECT_EQ(r.max_hyps_stationary_truth, 1)
       << (r.stationary_multi.empty() ? "" : r.stationary_multi.front());
-  // Issue 5: every vehicle within 40 m tracked from its first second in view on, with no
+  // The integration criterion: every vehicle within 40 m tracked from its first second in view on, with no
   // identity switch (tracker_eval.h: a vehicle hidden for more than 1.5 s, 3 s if not moving,
   // is new in view when seen again). Offline, deterministic: measured 2160 of 2160 due pairs, no
   // switch.

@@ -1,6 +1,6 @@
 // Two processes over udpm:// inside a private network namespace (ctest runs this through
 // scripts/vtrack-netns): every message of every type arrives, including 2 MB scans at 10 Hz for
-// 5 s with recv_buf_size in the subscriber's URL (DESIGN section 8).
+// 5 s with recv_buf_size in the subscriber's URL (docs/design.md, section 8).
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 #include <sys/wait.h>

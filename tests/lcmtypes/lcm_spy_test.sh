@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # lcm-spy, started headless under Xvfb with the project's jar on its CLASSPATH, finds every
 # vtrack message type. Debian's lcm-spy passes -Xincgc, which OpenJDK 17 refuses unless told to
-# ignore unknown options (DESIGN section 8). Runs inside a private network namespace.
+# ignore unknown options (docs/design.md, section 8). Runs inside a private network namespace.
 #   usage: lcm_spy_test.sh JAR LCMTYPES_DIR
 set -euo pipefail
 jar=$1; types_dir=$2

@@ -40,7 +40,7 @@ TEST(LcmTypes, HugeScanRoundTrip) {
   RandomMessages r(2);
   const ladar_scan_t m = r.Scan(130000);
   const auto bytes = Encode(m);
-  // 22 bytes a point: the parallel-array layout of DESIGN section 2.
+  // 22 bytes a point: the parallel-array layout of docs/design.md, section 2.
   EXPECT_GT(bytes.size(), 130000u * 22u);
   EXPECT_LT(bytes.size(), 130000u * 22u + 200u);
   const ladar_scan_t out = RoundTrip(m);

@@ -79,7 +79,7 @@ TEST_F(CompareTest, ThreeModesOnTwoScenariosAndKitti) {
   for (const char* s : {"alpha", "beta", "kitti_0000", "ism", "vasm", "mht", "MOTA", "HOTA"}) {
     EXPECT_NE(out.find(s), std::string::npos) << s << "\n" << out;
   }
-  // The command lines of DESIGN section 8.
+  // The command lines of docs/design.md, section 8.
   const std::string c = ReadFile(calls);
   EXPECT_NE(c.find("vtrack-sim-log --scenario alpha --out run.lcm --seed 7"), std::string::npos) << c;
   EXPECT_NE(c.find("vtrack-sim-log --scenario config/beta.yaml --out run.lcm"), std::string::npos) << c;

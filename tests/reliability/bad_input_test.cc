@@ -1,4 +1,4 @@
-// Bad input into vtrack-tracker's node (DESIGN section 9), checked against a clean run of the
+// Bad input into vtrack-tracker's node (docs/design.md, section 9), checked against a clean run of the
 // same scenario rather than against expected counters alone: a message that the tracker must
 // refuse as a whole (wrong type, too short, truncated, inflated length field, empty / huge /
 // repeated / out-of-order scans, sweeps out of range, mountings and poses that are not

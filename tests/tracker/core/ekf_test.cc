@@ -248,7 +248,7 @@ TEST(Ekf, PredictScalesSystemNoise) {
 }
 
 // Many cycles of predict and very precise measurements from a very uncertain start: the
-// covariance stays symmetric positive definite (Joseph form, DESIGN note 7).
+// covariance stays symmetric positive definite (Joseph form, docs/design.md, note 7).
 TEST(Ekf, CovarianceStaysSymmetricPositiveDefinite) {
   const Ekf ekf(IsmParams(), VasmParams(), EkfParams{0.999999999});
   std::mt19937_64 rng(9);

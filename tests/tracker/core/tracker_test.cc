@@ -1,7 +1,7 @@
 // The whole tracker core on seeded synthetic scenes with known truth: a parked car and an
 // Ackermann car turning in front of a moving ego vehicle. Checks tracking accuracy, identity,
 // the hypothesis counts of the multi-hypothesis manager, determinism, and every bad input of
-// DESIGN section 9 with its counter.
+// docs/design.md, section 9 with its counter.
 #include "tracker/core/tracker.h"
 
 #include <gtest/gtest.h>

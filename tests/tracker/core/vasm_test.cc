@@ -322,7 +322,7 @@ TEST(Vasm, ProcessNoiseIsSymmetricPositiveSemiDefinite) {
 }
 
 // Straight motion at the axis point (L = 0), theta = 0: the local block is the paper's Eq. (12),
-// with signed v and gamma dt^3/3 in the (theta, theta) entry (DESIGN note 3); (x, v) is Eq. (3);
+// with signed v and gamma dt^3/3 in the (theta, theta) entry (docs/design.md, note 3); (x, v) is Eq. (3);
 // L is eps_L dt.
 TEST(Vasm, AtAxisPointQIsEq12WithSignedV) {
   VasmParams p;

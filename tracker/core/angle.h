@@ -8,7 +8,7 @@ namespace vtrack {
 
 inline constexpr double kPi = std::numbers::pi;
 
-// Wraps an angle to (-pi, pi]. DESIGN note 4: every angle difference is wrapped to this range.
+// Wraps an angle to (-pi, pi]. docs/design.md note 4: every angle difference is wrapped to this range.
 inline double WrapToPi(double a) {
   double r = std::remainder(a, 2.0 * kPi);  // in [-pi, pi]
   if (r <= -kPi) r += 2.0 * kPi;

@@ -1,4 +1,4 @@
-// Association of segments to tracks (not in the paper; DESIGN section 4): by the predicted
+// Association of segments to tracks (not in the paper; docs/design.md, section 4.4): by the predicted
 // rectangle and its visible faces, with one global assignment.
 //
 // For each track, the predicted rectangle grown by a gate margin (gate_margin + gate_sigma *
@@ -6,7 +6,7 @@
 // track if at least min_inside_fraction of its returns fall inside the gate. The cost of the
 // pair is
 //     cost = mean over inside returns of the distance to the nearest visible face of the
-//            predicted rectangle (Eq. 15 per-face visibility, DESIGN note 4)
+//            predicted rectangle (Eq. 15 per-face visibility, docs/design.md note 4)
 //          + outside_penalty * (1 - inside fraction),
 // so a segment that lies where the sensor should see the vehicle's faces is preferred over one
 // that merely overlaps it. One global minimum-cost assignment (Hungarian method, solved per

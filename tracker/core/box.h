@@ -1,6 +1,6 @@
 // The vehicle rectangle (paper Section 2.3): centre, orientation of the length axis, length and
 // width; its corners and faces, point containment, and which faces a sensor can see (Eq. 15 in
-// its per-face form, DESIGN note 4).
+// its per-face form, docs/design.md note 4).
 #pragma once
 
 #include <Eigen/Core>

@@ -7,7 +7,7 @@
 //   x- = f(x+, dt),   P- = Phi P+ Phi^T + k Q(x+, dt),   Phi = df/dx at x+.
 // Update (Eq. 19, last three lines) with the measurement z = (x, y, theta) of Eq. 14 and its R:
 //   nu = z - H x-, with the theta component wrapped to (-pi, pi]: the fitting resolves theta's
-//        90/180 deg ambiguity against the prediction (DESIGN note 6), but the innovation must
+//        90/180 deg ambiguity against the prediction (docs/design.md note 6), but the innovation must
 //        still be the short way round the circle;
 //   S  = H P- H^T + R,   NIS = nu^T S^-1 nu;
 //   gate: the update is refused when NIS exceeds the chi-square (3 dof) quantile of the
@@ -15,7 +15,7 @@
 //   K  = P- H^T S^-1,   x+ = x- + K nu (theta wrapped),
 //   P+ = (I - K H) P- (I - K H)^T + K R K^T  (Joseph form, then symmetrised).
 // The Joseph form equals Eq. 19's P- - K H P- in exact arithmetic and keeps P+ symmetric positive
-// definite in floating point (DESIGN note 7).
+// definite in floating point (docs/design.md note 7).
 //
 // Errors: caller mistakes (negative or non-finite dt, noise scale <= 0, a hypothesis of another
 // kind than the model) throw std::invalid_argument naming the value. Bad data (a measurement

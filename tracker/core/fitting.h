@@ -30,7 +30,7 @@
 // (the a-posteriori variance factor), so a vehicle that is not a perfect rectangle does not give
 // an overconfident z.
 //
-// z and R at the vehicle centre (DESIGN note 5). The residual of an inlier p on the face with unit
+// z and R at the vehicle centre (docs/design.md note 5). The residual of an inlier p on the face with unit
 // normal n is r = n . (p - c) - h, with c the centre and h the half-dimension, so its Jacobian
 // row in (x, y, theta) is [-n_x, -n_y, n x (p - c)] (the lever arm about the centre: Eq. 18 with
 // the Hessian evaluated at the centre). For a corner the shape places the centre:
@@ -52,7 +52,7 @@
 // The shape estimate's own uncertainty (length_std_m, width_std_m) adds (std / 2)^2 to the
 // centre's variance along each body axis.
 //
-// Which vehicle corner or face (DESIGN note 6). Orientation from a fit is known modulo 90 deg:
+// Which vehicle corner or face (docs/design.md note 6). Orientation from a fit is known modulo 90 deg:
 // the candidate headings are phi + k * 90 deg.
 //  - With a predicted heading (existing track): theta is the candidate nearest to it (tau of
 //    Eq. 17 is the multiple of 90 deg that brings phi nearest the prediction).
@@ -61,7 +61,7 @@
 //    by side_face_min_excess_m or is seen at an incidence (its normal against the ray) beyond
 //    side_face_min_incidence_deg, else the front or rear. The sign of the heading cannot be
 //    observed: theta is taken in (-pi/2, pi/2]. The tracker resolves both ambiguities over time
-//    (motion, and the two VASMs 90 deg apart, DESIGN note 9).
+//    (motion, and the two VASMs 90 deg apart, docs/design.md, section 4.13).
 // The faces then follow from the outward normals: a fitted face's outward normal points to the
 // sensor side; for a corner the body lies between the two edges. Faces are numbered as in box.h.
 // The predicted position is deliberately not used: z depends on the prediction only through the

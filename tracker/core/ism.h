@@ -19,7 +19,7 @@
 // This Q is the exact discretisation of the continuous model, so predicting in several short
 // steps gives the same covariance as one long step.
 //
-// Measurement (Eq. 14, DESIGN note 1): H picks state indices 0, 2, 4.
+// Measurement (Eq. 14, docs/design.md note 1): H picks state indices 0, 2, 4.
 #pragma once
 
 #include <string>

@@ -7,7 +7,7 @@
 //   VASM (vasm.h, Sec 2.2): (x, y, L, v, theta, theta_dot)
 // (x, y) is always the centre of the vehicle rectangle in the world frame [m] and theta the
 // direction of its length axis [rad], wrapped to (-pi, pi]. The measurement of Eq. 14 picks
-// (x, y, theta): ISM indices 0, 2, 4 and VASM indices 0, 1, 4 (DESIGN note 1).
+// (x, y, theta): ISM indices 0, 2, 4 and VASM indices 0, 1, 4 (docs/design.md note 1).
 //
 // Conversions between the models go through the ISM state, which is the model-free description
 // of a rigid body in the plane: centre, centre velocity, heading, yaw rate. Each model maps its

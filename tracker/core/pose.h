@@ -1,5 +1,5 @@
 // Ego poses over time: interpolation between two poses, and a short history that answers "where
-// was the vehicle at time t" for motion compensation of every LADAR return (DESIGN section 4).
+// was the vehicle at time t" for motion compensation of every LADAR return (docs/design.md, section 4.2).
 #pragma once
 
 #include <Eigen/Geometry>

@@ -1,4 +1,4 @@
-// Preprocessing of one LADAR sweep (not in the paper; DESIGN section 4, "needed all the same"):
+// Preprocessing of one LADAR sweep (not in the paper; docs/design.md, section 4.2):
 //
 //  1. drop returns that are not finite, closer than min_range or farther than max_range, or
 //     whose time offset lies outside the sweep;

@@ -1,4 +1,5 @@
-// Segmentation of the preprocessed returns into objects (not in the paper; DESIGN section 4).
+// Segmentation of the preprocessed returns into objects (not in the paper; docs/design.md,
+// section 4.3).
 //
 // - Single-plane scans (num_rings == 1): returns are in scan order; a new segment starts where
 //   two consecutive returns lie farther apart than max(jump_abs, jump_rel * range) (a range

@@ -1,4 +1,4 @@
-// The vehicle shape model, paper Section 2.3 and DESIGN note 8: the length and the width of the
+// The vehicle shape model, paper Section 2.3 and docs/design.md note 8: the length and the width of the
 // vehicle rectangle, each estimated from a histogram of its measurements.
 //
 // Each measurement adds its weight to the histogram (shared between the two nearest bins);

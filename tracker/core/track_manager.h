@@ -1,6 +1,6 @@
 // Tracks and their hypotheses: the paper's multi-hypothesis manager (Section 2.5) and the track
-// life cycle. Decisions the paper leaves open (DESIGN note 9) are fixed here and documented in
-// tracker/README.md; each is a parameter of TrackManagerParams.
+// life cycle. Decisions the paper leaves open are fixed here (docs/design.md, section 4.13); each
+// is a parameter of TrackManagerParams.
 //
 // Hypotheses. Every object starts with one hypothesis: an ISM (modes mht and ism) or a VASM
 // (mode vasm). In mode mht an object judged a mover gains VASM hypotheses, up to

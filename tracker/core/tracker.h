@@ -11,7 +11,7 @@
 // cycle -> report at the scan's utime (the time of the ground truth and of track_list_t.utime).
 //
 // Bad input is dropped and counted by reason (rejects(); the keys are listed in
-// tracker/README.md). A message more than time_jump_reset_us older than the newest one (a
+// tracker/README.md and docs/reliability.md). A message more than time_jump_reset_us older than the newest one (a
 // looped log) resets the tracker: tracks, poses and queue are cleared, ids continue.
 #pragma once
 

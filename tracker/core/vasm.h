@@ -11,7 +11,7 @@
 // Ackerman car it is the middle of the rear axle, for a skid-steer vehicle near the centre.
 //
 // Mean propagation (nonlinear, constant v and theta_dot over dt), with a = theta_dot dt and
-// sinc(a) = sin(a)/a (unnormalised, DESIGN note 2):
+// sinc(a) = sin(a)/a (unnormalised, docs/design.md note 2):
 //   Eq. (5)  the axis point in its own frame C_0:
 //            0x = v dt sinc(a),   0y = v theta_dot dt^2 sinc^2(a/2) / 2
 //   Eq. (6)  the centre in the centre frame C_c at the start of the interval:
@@ -33,7 +33,7 @@
 //   dtheta_c = atan2(-L theta_dot, v) from theta, and speed v_c = |(v, -L theta_dot)| >= 0
 // (the paper's v / cos(dtheta_c), computed without the division that fails at v = 0).
 //
-// System noise (Eq. 12-13, derived here; DESIGN note 3). Three independent white noises drive the
+// System noise (Eq. 12-13, derived here; docs/design.md note 3). Three independent white noises drive the
 // model: an along-arc acceleration on v (spectral density alpha [m^2/s^3]), an angular
 // acceleration on theta_dot (gamma [rad^2/s^3]), and a random walk of L (epsilon_L [m^2/s]).
 // Work in the frame of the vehicle at the start of the interval, s along theta and n to its left,

@@ -2,12 +2,14 @@
 # message headers, the jar, and a CMake package so that other projects can find_package(vtrack).
 include(CMakePackageConfigHelpers)
 
-install(TARGETS vtrack_msgs vtrack_core EXPORT vtrackTargets
+install(TARGETS vtrack_msgs vtrack_base vtrack_core EXPORT vtrackTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(FILES ${VTRACK_GENERATED_HEADERS} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/vtrack)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/tracker/core/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/vtrack/tracker/core
+  FILES_MATCHING PATTERN "*.h")
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/base/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/vtrack/base
   FILES_MATCHING PATTERN "*.h")
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/lcmtypes/util/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/vtrack/lcmtypes/util
   FILES_MATCHING PATTERN "*.h")

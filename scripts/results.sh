@@ -135,7 +135,8 @@ if [ -n "$scorer" ]; then
       tracks=$work/runs/$item/tracks_$mode.lcm
       [ -s "$tracks" ] || continue
       say "tracker-eval-scores $item / $mode"
-      line=$("$scorer" "$work/runs/$item/run.lcm" "$tracks" | head -1) \
+      # sed, not head: head would close the pipe early and the scorer die of SIGPIPE (pipefail).
+      line=$("$scorer" "$work/runs/$item/run.lcm" "$tracks" | sed -n 1p) \
         || die "tracker-eval-scores failed on $item / $mode"
       row=$(sed -nE 's/^due ([0-9]+), matched ([0-9]+) \([^)]*\), id switches ([0-9]+), pos RMSE ([-0-9.na]+) m, heading RMSE ([-0-9.na]+) deg \(axis\), mover heading RMSE ([-0-9.na]+) deg.*/| \2\/\1 | \3 | \4 | \5 \/ \6 |/p' <<<"$line")
       [ -n "$row" ] || die "tracker-eval-scores printed an unexpected line: $line"

@@ -28,7 +28,7 @@
 #include <utility>
 #include <vector>
 
-#include "tracker/core/pose.h"
+#include "base/pose.h"
 #include "vtrack/ladar_scan_t.hpp"
 #include "vtrack/object_list_t.hpp"
 #include "vtrack/pose_t.hpp"

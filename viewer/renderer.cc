@@ -11,7 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace vtrack::viewer {
 namespace {

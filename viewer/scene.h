@@ -15,7 +15,7 @@
 #include <utility>
 #include <vector>
 
-#include "tracker/core/box.h"
+#include "base/box.h"
 
 namespace vtrack::viewer {
 

@@ -5,7 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "tracker/core/pose.h"
+#include "base/pose.h"
 #include "viewer/msg_convert.h"
 
 namespace vtrack::viewer {

@@ -13,7 +13,7 @@
 #include "lcmtypes/util/decode.h"
 #include "lcmtypes/util/log_reader.h"
 #include "log_tools/eval/gated_assignment.h"
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 #include "vtrack/ladar_scan_t.hpp"
 #include "vtrack/pose_t.hpp"
 

@@ -44,7 +44,7 @@
 #include <vector>
 
 #include "log_tools/eval/clear_mot.h"
-#include "tracker/core/pose.h"
+#include "base/pose.h"
 #include "vtrack/object_list_t.hpp"
 #include "vtrack/track_list_t.hpp"
 

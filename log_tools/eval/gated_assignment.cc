@@ -5,7 +5,7 @@
 #include <limits>
 #include <numeric>
 
-#include "tracker/core/association.h"
+#include "base/assignment.h"
 
 namespace vtrack::eval {
 namespace {

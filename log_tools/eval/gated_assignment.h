@@ -5,7 +5,7 @@
 // allowed pairs and, among those, of minimum total cost: the semantics that CLEAR MOT
 // (Bernardin & Stiefelhagen 2008, Sec. 2.1.1) and HOTA (Luiten et al. 2021, Sec. 5) ask of their
 // Hungarian step. It is solved exactly with the project's Hungarian solver
-// (vtrack::SolveAssignment, tracker/core/association.h): forbidden pairs get a cost larger
+// (vtrack::SolveAssignment, base/assignment.h): forbidden pairs get a cost larger
 // than any sum of allowed costs, so that the solver's complete assignment uses as few of them as
 // possible, and those are then dropped. The problem is split into the connected components of
 // the allowed pairs first (the optimum decomposes over them), so that the cubic cost of the

@@ -9,7 +9,7 @@
 #include <stdexcept>
 
 #include "log_tools/eval/report.h"
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace vtrack::eval {
 

@@ -9,8 +9,8 @@
 #include <Eigen/Geometry>
 
 #include "lcmtypes/util/decode.h"
-#include "tracker/core/angle.h"
-#include "tracker/core/pose.h"
+#include "base/angle.h"
+#include "base/pose.h"
 #include "vtrack/hypothesis_t.hpp"
 #include "vtrack/ladar_scan_t.hpp"
 #include "vtrack/object_list_t.hpp"

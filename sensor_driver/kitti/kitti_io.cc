@@ -12,7 +12,7 @@
 #include <sstream>
 #include <string_view>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 #include "vtrack/object_t.hpp"
 
 namespace vtrack::kitti {

@@ -5,7 +5,7 @@
 #include <limits>
 #include <sstream>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace vtrack::kitti {
 

@@ -9,8 +9,8 @@
 #include <set>
 #include <sstream>
 
-#include "tracker/core/angle.h"
-#include "tracker/core/pose.h"
+#include "base/angle.h"
+#include "base/pose.h"
 
 namespace vtrack::kitti {
 namespace fs = std::filesystem;

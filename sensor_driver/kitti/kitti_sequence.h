@@ -83,7 +83,7 @@ class Sequence {
   // world_from_body at FrameUtime(i).
   const Eigen::Isometry3d& WorldFromBody(int i) const;
   // Ego pose at FrameUtime(i), and at any time in [FirstPoseUtime(), LastPoseUtime()]: between
-  // frames linear in position and slerp in rotation (tracker/core/pose.h InterpolatePose), beyond
+  // frames linear in position and slerp in rotation (base/pose.h InterpolatePose), beyond
   // the first/last frame (half a sweep) extrapolated at constant velocity. vel, rotation_rate and
   // accel come from central differences of the frame poses, interpolated linearly; accel is the
   // kinematic acceleration of the body origin (no gravity), in the body frame. pos_std and

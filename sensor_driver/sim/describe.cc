@@ -8,7 +8,7 @@
 
 #include <Eigen/Geometry>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace vtrack::sim {
 namespace {

@@ -10,8 +10,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "tracker/core/angle.h"
-#include "tracker/core/pose.h"
+#include "base/angle.h"
+#include "base/pose.h"
 
 namespace vtrack::sim {
 namespace {

@@ -10,7 +10,7 @@
 #include <set>
 #include <sstream>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 #ifndef VTRACK_SOURCE_DIR
 #define VTRACK_SOURCE_DIR ""

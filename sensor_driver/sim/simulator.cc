@@ -6,7 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 #include "vtrack/object_t.hpp"
 
 namespace vtrack::sim {

@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace vtrack::sim {
 namespace {

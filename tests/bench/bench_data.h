@@ -19,7 +19,7 @@
 #include "sensor_driver/sim/scenario.h"
 #include "sensor_driver/sim/simulator.h"
 #include "tracker/config.h"
-#include "tracker/core/pose.h"
+#include "base/pose.h"
 #include "tracker/core/tracker.h"
 #include "tracker/lcm_convert.h"
 

@@ -10,7 +10,7 @@
 #include <random>
 
 #include "tests/tracker/core/synthetic_scan.h"
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 #include "tracker/core/fitting.h"
 
 namespace vtrack {

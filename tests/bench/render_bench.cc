@@ -10,7 +10,7 @@
 #include <random>
 
 #include "lcmtypes/util/decode.h"
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 #include "viewer/frame_assembler.h"
 #include "viewer/frame_output.h"
 #include "viewer/renderer.h"

@@ -35,7 +35,7 @@
 #include <vector>
 
 #include "tests/bench/bench_data.h"
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace {
 

@@ -8,7 +8,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cmake --install "$build" --prefix "$work/prefix" >"$work/install.log" 2>&1 || { cat "$work/install.log"; exit 1; }
 for f in lib/cmake/vtrack/vtrackConfig.cmake include/vtrack/track_t.hpp share/java/vtrack_lcmtypes.jar \
-         include/vtrack/tracker/core/box.h bin/vtrack-netns; do
+         include/vtrack/base/box.h bin/vtrack-netns; do
   [ -e "$work/prefix/$f" ] || { echo "FAIL: not installed: $f"; exit 1; }
 done
 # A sanitized build installs instrumented static libraries: a consumer links them with the same

@@ -1,5 +1,7 @@
 #include "tests/integration/tracker_eval.h"
 
+#include <Eigen/Core>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -10,8 +12,8 @@
 
 #include "lcmtypes/util/decode.h"
 #include "lcmtypes/util/log_reader.h"
-#include "tracker/core/angle.h"
-#include "tracker/core/association.h"
+#include "base/angle.h"
+#include "base/assignment.h"
 #include "vtrack/object_list_t.hpp"
 #include "vtrack/pose_t.hpp"
 #include "vtrack/track_list_t.hpp"

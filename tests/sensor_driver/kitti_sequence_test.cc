@@ -13,9 +13,9 @@
 #include "sensor_driver/kitti/kitti_sequence.h"
 #include "tests/sensor_driver/kitti_synthetic.h"
 #include "tests/support/test_env.h"
-#include "tracker/core/angle.h"
-#include "tracker/core/box.h"
-#include "tracker/core/pose.h"
+#include "base/angle.h"
+#include "base/box.h"
+#include "base/pose.h"
 #include "vtrack/object_t.hpp"
 
 namespace vtrack::kitti {

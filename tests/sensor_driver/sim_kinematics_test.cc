@@ -11,7 +11,7 @@
 
 #include "sensor_driver/sim/piecewise_linear.h"
 #include "sensor_driver/sim/vehicle_motion.h"
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace vtrack::sim {
 namespace {

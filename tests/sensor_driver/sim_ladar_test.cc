@@ -10,7 +10,7 @@
 
 #include "sensor_driver/sim/ladar.h"
 #include "sensor_driver/sim/scene.h"
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace vtrack::sim {
 namespace {
@@ -74,7 +74,7 @@ LadarParams Planar(double res_deg, double noise) {
   return p;
 }
 
-// Corners of a box footprint, counter-clockwise from front-left (as tracker/core/box.h).
+// Corners of a box footprint, counter-clockwise from front-left (as base/box.h).
 std::array<Vector2d, 4> Corners(const SceneObject& o) {
   const Vector2d a(std::cos(o.yaw), std::sin(o.yaw)), n(-a.y(), a.x());
   const Vector2d l = 0.5 * o.length * a, w = 0.5 * o.width * n;

@@ -14,8 +14,8 @@
 #include "sensor_driver/sim/scenario.h"
 #include "sensor_driver/sim/simulator.h"
 #include "tests/support/test_env.h"
-#include "tracker/core/angle.h"
-#include "tracker/core/box.h"
+#include "base/angle.h"
+#include "base/box.h"
 
 namespace vtrack::sim {
 namespace {

@@ -9,7 +9,7 @@
 
 #include "sensor_driver/sim/ladar.h"
 #include "sensor_driver/sim/scene.h"
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace vtrack::sim {
 namespace {

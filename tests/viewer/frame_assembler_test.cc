@@ -7,8 +7,8 @@
 #include <set>
 
 #include "tests/viewer/test_messages.h"
-#include "tracker/core/angle.h"
-#include "tracker/core/pose.h"
+#include "base/angle.h"
+#include "base/pose.h"
 #include "viewer/frame_assembler.h"
 #include "viewer/msg_convert.h"
 #include "viewer/scene_builder.h"

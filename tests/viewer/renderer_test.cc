@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "tests/viewer/pixel_util.h"
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 #include "viewer/renderer.h"
 
 namespace vtrack::viewer {

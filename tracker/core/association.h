@@ -34,7 +34,8 @@
 #include <string>
 #include <vector>
 
-#include "tracker/core/box.h"
+#include "base/assignment.h"
+#include "base/box.h"
 #include "tracker/core/preprocess.h"
 #include "tracker/core/segmentation.h"
 
@@ -99,11 +100,6 @@ struct AssociationResult {
   std::int32_t num_ignored = 0; // leftover segments on a track's rectangle but not merged
 };
 
-// Solves min sum cost[r][assign[r]] over one-to-one assignments of rows to columns
-// (rows <= cols), cost row-major rows x cols. Returns assign (column per row). Hungarian method
-// with potentials, O(rows^2 cols). Hand-written: the core depends on Eigen only, and the
-// assignment is 60 lines that a brute-force test checks.
-std::vector<int> SolveAssignment(const std::vector<double>& cost, int rows, int cols);
 
 class Associator {
  public:

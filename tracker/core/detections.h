@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "tracker/core/association.h"
-#include "tracker/core/box.h"
+#include "base/box.h"
 #include "tracker/core/motion_model.h"
 
 namespace vtrack {

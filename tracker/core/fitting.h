@@ -88,7 +88,7 @@
 #include <string>
 #include <vector>
 
-#include "tracker/core/box.h"
+#include "base/box.h"
 
 namespace vtrack {
 

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 #include "tracker/core/orientation.h"
 
 namespace vtrack {

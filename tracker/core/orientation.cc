@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <utility>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace vtrack {
 namespace {

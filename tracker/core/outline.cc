@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace vtrack {
 namespace {

@@ -31,7 +31,7 @@
 #include <string>
 #include <vector>
 
-#include "tracker/core/pose.h"
+#include "base/pose.h"
 #include "tracker/core/scan.h"
 
 namespace vtrack {

@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "tracker/core/detections.h"
-#include "tracker/core/pose.h"
+#include "base/pose.h"
 #include "tracker/core/scan.h"
 #include "tracker/core/tracker_params.h"
 

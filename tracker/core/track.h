@@ -12,7 +12,7 @@
 #include <optional>
 #include <vector>
 
-#include "tracker/core/box.h"
+#include "base/box.h"
 #include "tracker/core/ekf.h"
 #include "tracker/core/fitting.h"
 #include "tracker/core/motion_model.h"

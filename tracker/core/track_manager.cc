@@ -5,7 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 #include "tracker/core/classification.h"
 #include "tracker/core/hypotheses.h"
 #include "tracker/core/life_cycle.h"
@@ -192,16 +192,7 @@ void TrackManager::Update(std::size_t index, const PointSet& points,
     GrowIntoRectangle(points, sensor_xy, seed, &t);
   }
   const bool any = UpdateHypotheses(points, sensor_xy, seed, tm, &t);
-  if (any) {
-    ++t.num_updates;
-    t.consecutive_misses = 0;
-    t.last_update_utime = tm;
-  } else {
-    ++t.consecutive_misses;
-  }
-  SelectHypothesis(params_.switch_margin, &t);
-  ReseedFailedHypotheses(ekf_, params_.fail_misses, &t);
-  if (any) TestMotion(&t, /*pose_measured=*/false);
+  AfterUpdate(any, tm, /*pose_measured=*/false, &t);
   if (any && !t.mover && !t.small_object && profile && !profile->empty()) {
     AlignToFullFace(ekf_, params_, points, sensor_xy, seed, *profile, &measurer_, &t);
   }
@@ -369,17 +360,21 @@ void TrackManager::UpdateWithBox(std::size_t index, const BoxMeasurement& b,
       any = true;
     }
   }
+  if (any) ++t.box_updates;
+  AfterUpdate(any, tm, /*pose_measured=*/true, &t);
+}
+
+void TrackManager::AfterUpdate(bool any, std::int64_t utime, bool pose_measured, Track* t) {
   if (any) {
-    ++t.num_updates;
-    ++t.box_updates;
-    t.consecutive_misses = 0;
-    t.last_update_utime = tm;
+    ++t->num_updates;
+    t->consecutive_misses = 0;
+    t->last_update_utime = utime;
   } else {
-    ++t.consecutive_misses;
+    ++t->consecutive_misses;
   }
-  SelectHypothesis(params_.switch_margin, &t);
-  ReseedFailedHypotheses(ekf_, params_.fail_misses, &t);
-  if (any) TestMotion(&t, /*pose_measured=*/true);
+  SelectHypothesis(params_.switch_margin, t);
+  ReseedFailedHypotheses(ekf_, params_.fail_misses, t);
+  if (any) TestMotion(t, pose_measured);
 }
 
 void TrackManager::ObserveBoxShape(const BoxMeasurement& b, double time_s,

@@ -70,7 +70,7 @@
 #include <vector>
 
 #include "tracker/core/association.h"
-#include "tracker/core/box.h"
+#include "base/box.h"
 #include "tracker/core/classification.h"
 #include "tracker/core/detections.h"
 #include "tracker/core/ekf.h"
@@ -133,6 +133,9 @@ class TrackManager {
   // The shape estimate's observations after an accepted update, and on creation.
   void ObserveShape(bool small, const PointSet& points, double time_s, TrackHypothesis* h) const;
   void ObserveFirstShape(bool small, const PointSet& points, TrackHypothesis* h) const;
+  // After the hypotheses' updates at utime (any: one was accepted): counts, the reported
+  // hypothesis, re-seeding, the mover test.
+  void AfterUpdate(bool any, std::int64_t utime, bool pose_measured, Track* t);
   // The mover test on this scan, and what follows a mover declaration. pose_measured: the
   // update measured the whole pose (a detector's box), not a fit of the returns.
   void TestMotion(Track* t, bool pose_measured) const;

@@ -6,7 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 #include "tracker/core/grazing_pieces.h"
 
 namespace vtrack {

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace vtrack {
 namespace {

@@ -4,8 +4,8 @@
 #include <vector>
 
 #include "lcmtypes/util/decode.h"
-#include "tracker/core/angle.h"
-#include "tracker/core/box.h"
+#include "base/angle.h"
+#include "base/box.h"
 #include "vtrack/track_list_t.hpp"
 
 int main() {

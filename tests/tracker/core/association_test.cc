@@ -11,7 +11,7 @@
 #include <random>
 #include <set>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 #include "tracker/core/segmentation.h"
 
 namespace vtrack {

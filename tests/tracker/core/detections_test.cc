@@ -10,7 +10,7 @@
 #include <random>
 #include <set>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 #include "tracker/core/tracker.h"
 
 namespace vtrack {

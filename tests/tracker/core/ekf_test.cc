@@ -11,7 +11,7 @@
 #include <random>
 #include <stdexcept>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace vtrack {
 namespace {

@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "tests/tracker/core/synthetic_scan.h"
-#include "tracker/core/angle.h"
-#include "tracker/core/box.h"
+#include "base/angle.h"
+#include "base/box.h"
 
 namespace vtrack {
 namespace {

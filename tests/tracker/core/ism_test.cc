@@ -8,7 +8,7 @@
 #include <stdexcept>
 
 #include "tests/tracker/core/jacobian_check.h"
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace vtrack {
 namespace {

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "tests/tracker/core/motion_truth.h"
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 #include "tracker/core/ekf.h"
 
 namespace vtrack {

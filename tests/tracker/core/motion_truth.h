@@ -9,7 +9,7 @@
 #include <cmath>
 #include <random>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 #include "tracker/core/motion_model.h"
 
 namespace vtrack::testing {

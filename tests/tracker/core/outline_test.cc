@@ -8,7 +8,7 @@
 #include <cmath>
 #include <vector>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 #include "tracker/core/tracker.h"
 
 namespace vtrack {

@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 #include "tracker/core/ekf.h"
 
 namespace vtrack {

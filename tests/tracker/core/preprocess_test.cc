@@ -8,8 +8,8 @@
 #include <limits>
 #include <random>
 
-#include "tracker/core/angle.h"
-#include "tracker/core/pose.h"
+#include "base/angle.h"
+#include "base/pose.h"
 
 namespace vtrack {
 namespace {

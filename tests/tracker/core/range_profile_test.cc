@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace vtrack {
 namespace {

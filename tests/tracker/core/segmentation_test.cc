@@ -8,7 +8,7 @@
 #include <random>
 #include <set>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace vtrack {
 namespace {

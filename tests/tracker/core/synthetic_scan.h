@@ -12,7 +12,7 @@
 #include <random>
 #include <vector>
 
-#include "tracker/core/box.h"
+#include "base/box.h"
 
 namespace vtrack::testing {
 

@@ -10,8 +10,8 @@
 #include <random>
 #include <vector>
 
-#include "tracker/core/angle.h"
-#include "tracker/core/box.h"
+#include "base/angle.h"
+#include "base/box.h"
 #include "tracker/core/scan.h"
 
 namespace vtrack::testing {

@@ -12,7 +12,7 @@
 
 #include "tests/tracker/core/jacobian_check.h"
 #include "tests/tracker/core/motion_truth.h"
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace vtrack {
 namespace {

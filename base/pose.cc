@@ -1,4 +1,4 @@
-#include "tracker/core/pose.h"
+#include "base/pose.h"
 
 #include <algorithm>
 #include <cmath>

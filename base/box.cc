@@ -1,8 +1,8 @@
-#include "tracker/core/box.h"
+#include "base/box.h"
 
 #include <cmath>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace vtrack {
 

@@ -1,4 +1,4 @@
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 #include <gtest/gtest.h>
 

@@ -1,11 +1,11 @@
-#include "tracker/core/box.h"
+#include "base/box.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace vtrack {
 namespace {

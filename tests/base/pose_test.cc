@@ -1,8 +1,8 @@
-#include "tracker/core/pose.h"
+#include "base/pose.h"
 
 #include <gtest/gtest.h>
 
-#include "tracker/core/angle.h"
+#include "base/angle.h"
 
 namespace vtrack {
 namespace {

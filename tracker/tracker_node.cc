@@ -18,53 +18,43 @@ TrackerNode::TrackerNode(const TrackerParams& params, NodeOptions options, Publi
   tracker_.SetFirstTrackId(options_.first_track_id);
 }
 
+template <class Msg>
+bool TrackerNode::DecodeOrCount(const std::string& channel, const void* data, std::size_t size,
+                                Msg* msg) {
+  std::string why;
+  const auto err = lcm_util::Decode(data, size, msg, &why);
+  if (err == lcm_util::DecodeError::kNone) return true;
+  ++decode_errors_;
+  ++decode_reasons_[lcm_util::DecodeErrorName(err)];
+  log_.Warn(lcm_util::DecodeErrorName(err), "dropped a " + channel + " message of " +
+                                                std::to_string(size) + " bytes: " +
+                                                lcm_util::DecodeErrorName(err) +
+                                                (why.empty() ? "" : " (" + why + ")"));
+  return false;
+}
+
+void TrackerNode::NoteArrival(std::int64_t utime) {
+  arrival_.emplace_back(utime, lcm_util::WallUtime());
+  if (arrival_.size() > 1000) arrival_.pop_front();
+}
+
 void TrackerNode::Handle(const std::string& channel, const void* data, std::size_t size) {
   // An LCM callback must never let an exception escape: anything unexpected is counted.
   try {
     if (channel == options_.scan_channel) {
       ladar_scan_t msg;
-      std::string why;
-      const auto err = lcm_util::Decode(data, size, &msg, &why);
-      if (err != lcm_util::DecodeError::kNone) {
-        ++decode_errors_;
-        ++decode_reasons_[lcm_util::DecodeErrorName(err)];
-        log_.Warn(lcm_util::DecodeErrorName(err), "dropped a " + channel + " message of " +
-                                                      std::to_string(size) + " bytes: " +
-                                                      lcm_util::DecodeErrorName(err) +
-                                                      (why.empty() ? "" : " (" + why + ")"));
-        return;
-      }
-      arrival_.emplace_back(msg.utime, lcm_util::WallUtime());
-      if (arrival_.size() > 1000) arrival_.pop_front();
+      if (!DecodeOrCount(channel, data, size, &msg)) return;
+      NoteArrival(msg.utime);
       tracker_.AddScan(ScanFromLcm(std::move(msg)), &outs_);
     } else if (channel == options_.pose_channel) {
       pose_t msg;
-      std::string why;
-      const auto err = lcm_util::Decode(data, size, &msg, &why);
-      if (err != lcm_util::DecodeError::kNone) {
-        ++decode_errors_;
-        ++decode_reasons_[lcm_util::DecodeErrorName(err)];
-        log_.Warn(lcm_util::DecodeErrorName(err),
-                  "dropped a " + channel + " message: " + lcm_util::DecodeErrorName(err) +
-                      (why.empty() ? "" : " (" + why + ")"));
-        return;
-      }
+      if (!DecodeOrCount(channel, data, size, &msg)) return;
       tracker_.AddPose(PoseFromLcm(msg), &outs_);
     } else if (channel == options_.detections_channel &&
                params_.detections.mode != InputMode::kScans) {
       detection_list_t msg;
-      std::string why;
-      const auto err = lcm_util::Decode(data, size, &msg, &why);
-      if (err != lcm_util::DecodeError::kNone) {
-        ++decode_errors_;
-        ++decode_reasons_[lcm_util::DecodeErrorName(err)];
-        log_.Warn(lcm_util::DecodeErrorName(err),
-                  "dropped a " + channel + " message: " + lcm_util::DecodeErrorName(err) +
-                      (why.empty() ? "" : " (" + why + ")"));
-        return;
-      }
-      arrival_.emplace_back(msg.utime, lcm_util::WallUtime());
-      if (arrival_.size() > 1000) arrival_.pop_front();
+      if (!DecodeOrCount(channel, data, size, &msg)) return;
+      NoteArrival(msg.utime);
       tracker_.AddDetections(DetectionsFromLcm(msg), &outs_);
     } else {
       return;

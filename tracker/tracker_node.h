@@ -54,6 +54,11 @@ class TrackerNode {
   std::int64_t tracks_published() const { return tracks_published_; }
 
  private:
+  // Decodes a message (checked); a bad one is counted by reason and warned about.
+  template <class Msg>
+  bool DecodeOrCount(const std::string& channel, const void* data, std::size_t size, Msg* msg);
+  // The wall time a scan or detection list of this utime arrived (for the latency figures).
+  void NoteArrival(std::int64_t utime);
   void Emit(std::vector<ScanOutput>* outs);
   void Warn();
 

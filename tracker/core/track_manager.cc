@@ -389,28 +389,43 @@ void TrackManager::ObserveBoxShape(const BoxMeasurement& b, double time_s,
 }
 
 bool TrackManager::CreateFromBox(const BoxMeasurement& b, const DetectionParams& dp) {
+  TrackHypothesis h = FirstHypothesis();
+  const CentreMeasurement m = BoxToMeasurement(b, b.box.theta, dp);
+  if (!m.z.allFinite() || !(b.box.length > 0.0) || !(b.box.width > 0.0)) return false;
+  StartFilter(m, &h);
+  ObserveBoxShape(b, static_cast<double>(b.utime) * 1e-6, &h);
   Track t;
+  t.box_updates = 1;
+  AddTrack(std::move(t), std::move(h), b.utime);
+  return true;
+}
+
+TrackHypothesis TrackManager::FirstHypothesis() const {
   TrackHypothesis h;
   h.shape = ShapeEstimator(shape_params_);
   h.inside_fraction = params_.mode == TrackerMode::kVasm && !params_.vasm_variants.empty()
                           ? params_.vasm_variants[0].inside_fraction
                           : params_.ism_inside_fraction;
-  const CentreMeasurement m = BoxToMeasurement(b, b.box.theta, dp);
-  if (!m.z.allFinite() || !(b.box.length > 0.0) || !(b.box.width > 0.0)) return false;
-  h.filter = ekf_.InitIsm(m);
-  if (params_.mode == TrackerMode::kVasm) h.filter = ekf_.Convert(h.filter, ModelKind::kVasm, 0.0);
-  ObserveBoxShape(b, static_cast<double>(b.utime) * 1e-6, &h);
-  h.last_logdet = std::log(std::max(1e-300, (2.0 * kPi * m.R).determinant()));
-  h.score_terms.push_back(0.5 * (3.0 + h.last_logdet));
+  return h;
+}
+
+void TrackManager::StartFilter(const CentreMeasurement& m, TrackHypothesis* h) const {
+  h->filter = ekf_.InitIsm(m);
+  if (params_.mode == TrackerMode::kVasm) h->filter = ekf_.Convert(h->filter, ModelKind::kVasm, 0.0);
+  h->last_logdet = std::log(std::max(1e-300, (2.0 * kPi * m.R).determinant()));
+  // The first scan's score term: the NIS of a measurement at its expected value (3, the
+  // measurement's dimension) with the measurement's own covariance.
+  h->score_terms.push_back(0.5 * (3.0 + h->last_logdet));
+}
+
+void TrackManager::AddTrack(Track t, TrackHypothesis h, std::int64_t utime) {
   t.id = next_id_++;
-  t.created_utime = b.utime;
-  t.state_utime = b.utime;
-  t.last_update_utime = b.utime;
+  t.created_utime = utime;
+  t.state_utime = utime;
+  t.last_update_utime = utime;
   t.num_updates = 1;
-  t.box_updates = 1;
   t.hyps.push_back(std::move(h));
   tracks_.push_back(std::move(t));
-  return true;
 }
 
 OrientedBox TrackManager::Box(std::size_t index) const {
@@ -424,31 +439,16 @@ bool TrackManager::Create(const PointSet& points, const Eigen::Vector2d& sensor_
                           std::uint64_t seed) {
   Track t;
   t.small_object = points.extent < params_.small_object_extent;
-  TrackHypothesis h;
-  h.shape = ShapeEstimator(shape_params_);
-  h.inside_fraction = params_.mode == TrackerMode::kVasm && !params_.vasm_variants.empty()
-                          ? params_.vasm_variants[0].inside_fraction
-                          : params_.ism_inside_fraction;
+  TrackHypothesis h = FirstHypothesis();
   CentreMeasurement m;
   if (!measurer_.Measure(t.small_object, points, sensor_xy, seed, std::nullopt, std::nullopt,
                          &h, &m)) {
     return false;
   }
   if (!m.z.allFinite() || !m.R.allFinite()) return false;
-  h.filter = ekf_.InitIsm(m);
-  if (params_.mode == TrackerMode::kVasm) h.filter = ekf_.Convert(h.filter, ModelKind::kVasm, 0.0);
+  StartFilter(m, &h);
   ObserveFirstShape(t.small_object, points, &h);
-  h.last_logdet = std::log(std::max(1e-300, (2.0 * kPi * m.R).determinant()));
-  // The first scan's score term: the NIS of a measurement at its expected value (3, the
-  // measurement's dimension) with the measurement's own covariance.
-  h.score_terms.push_back(0.5 * (3.0 + h.last_logdet));
-  t.id = next_id_++;
-  t.created_utime = points.mean_utime;
-  t.state_utime = points.mean_utime;
-  t.last_update_utime = points.mean_utime;
-  t.num_updates = 1;
-  t.hyps.push_back(std::move(h));
-  tracks_.push_back(std::move(t));
+  AddTrack(std::move(t), std::move(h), points.mean_utime);
   return true;
 }
 

@@ -136,6 +136,11 @@ class TrackManager {
   // After the hypotheses' updates at utime (any: one was accepted): counts, the reported
   // hypothesis, re-seeding, the mover test.
   void AfterUpdate(bool any, std::int64_t utime, bool pose_measured, Track* t);
+  // A new track: its first hypothesis (shape, inside fraction), its filter started from the
+  // first measurement with that measurement's score term, and the track added with the next id.
+  TrackHypothesis FirstHypothesis() const;
+  void StartFilter(const CentreMeasurement& m, TrackHypothesis* h) const;
+  void AddTrack(Track t, TrackHypothesis h, std::int64_t utime);
   // The mover test on this scan, and what follows a mover declaration. pose_measured: the
   // update measured the whole pose (a detector's box), not a fit of the returns.
   void TestMotion(Track* t, bool pose_measured) const;

@@ -56,7 +56,7 @@ int RunLive(const TrackerParams& params, NodeOptions options, const std::string&
   const std::string url = WithReceiveBuffer(url_in);
   auto lcm = lcm_util::OpenLcm(url);
   // Ids unique across restarts: a consumer must never see an id that meant another vehicle.
-  options.first_track_id = FirstTrackIdAt(lcm_util::WallUtime());
+  if (options.first_track_id <= 0) options.first_track_id = FirstTrackIdAt(lcm_util::WallUtime());
   TrackerNode node(params, options,
                    [&](std::int64_t, const std::string& ch, const void* data, std::size_t size) {
                      lcm->publish(ch, data, static_cast<unsigned int>(size));
@@ -146,6 +146,7 @@ int RunOffline(const TrackerParams& params, const NodeOptions& options, const st
 
 int main(int argc, char** argv) {
   std::string config, mode, input_mode, input, output, url;
+  std::int64_t first_track_id = 0;
   NodeOptions options;
   double status_period = 1.0;
   po::options_description desc(
@@ -162,6 +163,9 @@ int main(int argc, char** argv) {
       ("input", po::value(&input), "LCM log to track offline, as fast as possible")
       ("output", po::value(&output), "LCM log to write (with --input): TRACKS, TRACKER_STATUS, TRACK_DEBUG")
       ("debug", po::bool_switch(&options.debug), "also publish TRACK_DEBUG (large)")
+      ("first-track-id", po::value(&first_track_id),
+       "id of the first track (>= 1); default: live, from the start time (start ms x 100000 + 1,\n"
+       "so that a restarted tracker never reuses an id), offline 1 (reruns identical)")
       ("lcm-url", po::value(&url)->default_value(""),
        "LCM URL for live mode ('' = $LCM_DEFAULT_URL or LCM's default); recv_buf_size=4194304 "
        "is appended to udpm:// URLs that lack it")
@@ -190,6 +194,15 @@ int main(int argc, char** argv) {
   if (input.empty() != output.empty()) {
     std::cerr << "vtrack-tracker: --input and --output go together\n";
     return 2;
+  }
+  if (vm.count("first-track-id")) {
+    if (first_track_id < 1) {
+      std::cerr << "vtrack-tracker: --first-track-id " << first_track_id << " must be >= 1\n";
+      return 2;
+    }
+    options.first_track_id = first_track_id;
+  } else if (input.empty()) {
+    options.first_track_id = 0;  // live: from the start time (RunLive)
   }
   if (!(status_period > 0.0 && status_period <= 3600.0)) {
     std::cerr << "vtrack-tracker: --status-period " << status_period << " must be in (0, 3600]\n";

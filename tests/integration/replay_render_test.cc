@@ -83,7 +83,9 @@ TEST(ReplayRenderTest, LogPlayedIntoLiveTrackerAndRendererDrawsTheOfflineFrames)
     std::vector<std::string> live{Bin("vtrack-render"), "--lcm-url", kUrl, "--png-dir", dir + "/live_png"};
     live.insert(live.end(), view.begin(), view.end());
     Subprocess render(live, dir + "/render_live.txt");
-    Subprocess tracker({Bin("vtrack-tracker"), "--lcm-url", kUrl, "--debug"}, dir + "/tracker_live.txt");
+    // Ids from 1, as offline: the frames show them.
+    Subprocess tracker({Bin("vtrack-tracker"), "--lcm-url", kUrl, "--debug", "--first-track-id", "1"},
+                       dir + "/tracker_live.txt");
     std::this_thread::sleep_for(1500ms);  // both subscribed
     const int rc = RunCommand({"lcm-logplayer", "-l", kUrl, sim}, dir + "/player.txt", 60s);
     EXPECT_EQ(rc, 0) << ReadFile(dir + "/player.txt");

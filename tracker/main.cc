@@ -178,6 +178,10 @@ int main(int argc, char** argv) {
       ("status-channel", po::value(&options.status_channel)->default_value("TRACKER_STATUS"), "output status")
       ("status-period", po::value(&status_period)->default_value(1.0),
        "seconds between TRACKER_STATUS messages (wall time live, message time offline)")
+      ("print-config", "print the parameters in effect (--config, --mode, --input-mode applied) "
+       "as YAML and exit; with --config '' the built-in defaults (config/tracker.yaml)")
+      ("print-parameter-reference", "print every parameter's default, unit, range and reason "
+       "(Markdown, docs/parameters.md) and exit")
       ("quiet,q", "no progress output (offline)");
   po::variables_map vm;
   try {
@@ -189,6 +193,10 @@ int main(int argc, char** argv) {
   }
   if (vm.count("help")) {
     std::cout << desc << "\n";
+    return 0;
+  }
+  if (vm.count("print-parameter-reference")) {
+    WriteParameterReference(std::cout);
     return 0;
   }
   if (input.empty() != output.empty()) {
@@ -218,11 +226,11 @@ int main(int argc, char** argv) {
         params = LoadTrackerParams(config);
       }
     }
-    if (vm.count("mode") && !ParseTrackerMode(mode, &params.manager.mode)) {
+    if (vm.count("mode") && !param::FromName(mode, &params.manager.mode)) {
       std::cerr << "vtrack-tracker: --mode '" << mode << "' must be mht, ism or vasm\n";
       return 2;
     }
-    if (vm.count("input-mode") && !ParseInputMode(input_mode, &params.detections.mode)) {
+    if (vm.count("input-mode") && !param::FromName(input_mode, &params.detections.mode)) {
       std::cerr << "vtrack-tracker: --input-mode '" << input_mode << "' must be scans, boxes or fused\n";
       return 2;
     }
@@ -230,6 +238,10 @@ int main(int argc, char** argv) {
     if (!params.Validate(&error)) {
       std::cerr << "vtrack-tracker: invalid parameters: " << error << "\n";
       return 1;
+    }
+    if (vm.count("print-config")) {
+      WriteConfigYaml(params, std::cout);
+      return 0;
     }
     lcm_util::InstallStopHandlers();
     if (!input.empty()) {

@@ -27,7 +27,7 @@ bool SceneParams::Validate(std::string* error) const {
 }
 
 std::string SceneParams::FirstProblem() const {
-  if (std::string err = preprocess.FirstProblem(); !err.empty()) return err;
+  if (std::string err = param::FirstProblem(preprocess); !err.empty()) return err;
   std::ostringstream os;
   if (max_pose_extrapolation_us < 0 || max_pose_extrapolation_us > 10'000'000) {
     os << "scene.max_pose_extrapolation_us = " << max_pose_extrapolation_us

@@ -4,9 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
+#include "sensor_driver/sim/scenario.h"
 #include "tests/support/test_env.h"
 #include "tracker/config.h"
 #include "tracker/lcm_convert.h"
@@ -23,38 +26,71 @@ std::string ErrorOf(const std::string& yaml) {
   return "";
 }
 
+// Every field, through the one declaration list: the printed config of what the shipped file
+// loads equals the printed built-in defaults key for key.
 TEST(TrackerConfigTest, ShippedFileLoadsAndStatesTheDefaults) {
   const TrackerParams p = LoadTrackerParams(testing::SourceDir() + "/config/tracker.yaml");
-  const TrackerParams d;
   std::string error;
   EXPECT_TRUE(p.Validate(&error)) << error;
-  EXPECT_EQ(p.manager.mode, d.manager.mode);
-  EXPECT_EQ(p.manager.max_hypotheses, d.manager.max_hypotheses);
-  ASSERT_EQ(p.manager.vasm_variants.size(), d.manager.vasm_variants.size());
-  for (std::size_t i = 0; i < d.manager.vasm_variants.size(); ++i) {
-    EXPECT_EQ(p.manager.vasm_variants[i].inside_fraction, d.manager.vasm_variants[i].inside_fraction);
-    EXPECT_EQ(p.manager.vasm_variants[i].noise_scale, d.manager.vasm_variants[i].noise_scale);
+  std::ostringstream loaded, defaults;
+  WriteConfigYaml(p, loaded);
+  WriteConfigYaml(TrackerParams{}, defaults);
+  EXPECT_EQ(loaded.str(), defaults.str());
+  // Not vacuous: one changed field shows.
+  TrackerParams changed;
+  changed.shape.half_life += 1.0;
+  std::ostringstream other;
+  WriteConfigYaml(changed, other);
+  EXPECT_NE(other.str(), defaults.str());
+}
+
+// Every scenario shipped beside it loads as well (the simulator's own reader refuses unknown and
+// duplicate keys too).
+TEST(TrackerConfigTest, EveryShippedScenarioLoads) {
+  int loaded = 0;
+  for (const auto& entry :
+       std::filesystem::directory_iterator(testing::SourceDir() + "/config/scenarios")) {
+    if (entry.path().extension() != ".yaml") continue;
+    EXPECT_NO_THROW(sim::LoadScenario(entry.path().string(), 1.0)) << entry.path();
+    ++loaded;
   }
-  EXPECT_EQ(p.manager.mover_scans, d.manager.mover_scans);
-  EXPECT_EQ(p.manager.switch_margin, d.manager.switch_margin);
-  EXPECT_EQ(p.manager.fit_contour_deg, d.manager.fit_contour_deg);
-  EXPECT_EQ(p.manager.axis_swap_ratio, d.manager.axis_swap_ratio);
-  EXPECT_EQ(p.segmentation.cell_size, d.segmentation.cell_size);
-  EXPECT_EQ(p.segmentation.connectivity, d.segmentation.connectivity);
-  EXPECT_EQ(p.preprocess.ground, d.preprocess.ground);
-  EXPECT_EQ(p.preprocess.max_range, d.preprocess.max_range);
-  EXPECT_EQ(p.association.miss_cost, d.association.miss_cost);
-  EXPECT_EQ(p.input.max_pose_wait_us, d.input.max_pose_wait_us);
-  EXPECT_EQ(p.fit.max_scoring_points, d.fit.max_scoring_points);
-  EXPECT_EQ(p.vasm.epsilon_L, d.vasm.epsilon_L);
-  EXPECT_EQ(p.vasm.initial_L, d.vasm.initial_L);
-  EXPECT_EQ(p.vasm.initial_L_std, d.vasm.initial_L_std);
-  EXPECT_EQ(p.fit.max_inlier_gap_m, d.fit.max_inlier_gap_m);
-  EXPECT_EQ(p.manager.contour_support_height, d.manager.contour_support_height);
-  EXPECT_EQ(p.manager.contour_support_range, d.manager.contour_support_range);
-  EXPECT_EQ(p.ism.alpha, d.ism.alpha);
-  EXPECT_EQ(p.ekf.gate_probability, d.ekf.gate_probability);
-  EXPECT_EQ(p.shape.half_life, d.shape.half_life);
+  EXPECT_GE(loaded, 6);
+}
+
+TEST(TrackerConfigTest, DuplicateKeysEmptyFilesAndDirectoriesAreRefused) {
+  const std::string twice = ErrorOf("association:\n  miss_cost: 3\n  gate_sigma: 2\n  miss_cost: -1\n");
+  EXPECT_NE(twice.find("test.yaml: association.miss_cost appears twice (lines 2 and 4)"), std::string::npos)
+      << twice;
+  EXPECT_NE(ErrorOf("ism:\n  alpha: 1\nism:\n  beta: 1\n").find("ism appears twice"), std::string::npos);
+  EXPECT_NE(ErrorOf("manager:\n  vasm_variants:\n    - {inside_fraction: 0.5, inside_fraction: 0.6}\n")
+                .find("manager.vasm_variants[0].inside_fraction appears twice"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("").find("holds no section"), std::string::npos);
+  EXPECT_NE(ErrorOf("# nothing but a comment\n").find("holds no section"), std::string::npos);
+  const std::string dir = testing::ScratchDir("config_dir");
+  try {
+    LoadTrackerParams(dir);
+    ADD_FAILURE() << "a directory was loaded";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("is not a readable file (a directory)"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(LoadTrackerParams(dir + "/absent.yaml"), std::runtime_error);
+}
+
+// Each declared range is enforced on reading, naming file, key, value and the rule.
+TEST(TrackerConfigTest, DeclaredRangesAreEnforced) {
+  EXPECT_NE(ErrorOf("ekf:\n  gate_probability: 1\n").find("test.yaml: ekf.gate_probability = 1.0 -: must be in (0, 1)"),
+            std::string::npos)
+      << ErrorOf("ekf:\n  gate_probability: 1\n");
+  EXPECT_NE(ErrorOf("manager:\n  vasm_variants:\n    - {inside_fraction: 2, noise_scale: 1}\n")
+                .find("manager.vasm_variants[0].inside_fraction = 2.0 -: must be in [0, 1]"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("input:\n  max_queued_scans: 2.5\n").find("input.max_queued_scans = '2.5' is not a valid integer"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("detections:\n  gate_m: 9\n").find("detections.gate_m = 9.0 m: must be <= max_gate_m"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("preprocess:\n  min_height: .nan\n").find("preprocess.min_height = nan m: must be finite"),
+            std::string::npos);
 }
 
 TEST(TrackerConfigTest, OverridesAndPartialFiles) {
@@ -67,7 +103,9 @@ TEST(TrackerConfigTest, OverridesAndPartialFiles) {
   EXPECT_EQ(p.manager.vasm_variants[0].noise_scale, 2.0);
   EXPECT_EQ(p.preprocess.ground, PreprocessParams::Ground::kBand);
   EXPECT_EQ(p.segmentation.cell_size, SegmentationParams{}.cell_size);  // untouched default
-  EXPECT_NO_THROW(ParseTrackerParams("", "empty"));
+  // An empty or comment-only file is refused (a config that sets nothing is a mistake).
+  EXPECT_THROW(ParseTrackerParams("", "empty"), std::runtime_error);
+  EXPECT_THROW(ParseTrackerParams("# only a comment\n", "comment"), std::runtime_error);
 }
 
 TEST(TrackerConfigTest, BadFilesNameFileKeyAndValue) {

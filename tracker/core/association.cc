@@ -15,12 +15,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Slack on the bounds of a created rectangle, for the rounding of its corners.
 constexpr double kBoundsSlack = 1e-3;  // [m]
 
-std::string Bad(const char* key, double value, const char* constraint) {
-  std::ostringstream os;
-  os << "association." << key << " = " << value << ": " << constraint;
-  return os.str();
-}
-
 // The per-return distances below are compared and summed once per return and track, the
 // costliest loops of a KITTI scan: squares are compared instead (sqrt is monotonic, so
 // sqrt(min(a, b)) = min(sqrt(a), sqrt(b)) exactly) and std::hypot's care for overflow, needless
@@ -86,39 +80,11 @@ struct UnionFind {
 
 }  // namespace
 
-bool AssociationParams::Validate(std::string* error) const {
-  const std::string e = FirstProblem();
-  if (!e.empty() && error) *error = e;
-  return e.empty();
-}
-
-std::string AssociationParams::FirstProblem() const {
-  if (!(gate_margin >= 0.0)) return Bad("gate_margin", gate_margin, "must be >= 0");
-  if (!(gate_sigma >= 0.0)) return Bad("gate_sigma", gate_sigma, "must be >= 0");
+std::string AssociationParams::CrossProblem() const {
   if (!(max_gate_margin >= gate_margin))
-    return Bad("max_gate_margin", max_gate_margin, "must be >= gate_margin");
-  if (!(min_inside_fraction > 0.0 && min_inside_fraction <= 1.0))
-    return Bad("min_inside_fraction", min_inside_fraction, "must be in (0, 1]");
-  if (!(outside_penalty >= 0.0)) return Bad("outside_penalty", outside_penalty, "must be >= 0");
-  if (!(miss_cost > 0.0)) return Bad("miss_cost", miss_cost, "must be > 0");
-  if (!(mover_max_length >= 0.0)) return Bad("mover_max_length", mover_max_length, "must be >= 0");
-  if (!(mover_column_width >= 0.0))
-    return Bad("mover_column_width", mover_column_width, "must be >= 0");
-  if (!(merge_fraction > 0.0 && merge_fraction <= 1.0))
-    return Bad("merge_fraction", merge_fraction, "must be in (0, 1]");
-  if (!(ignore_max_extent >= 0.0 && ignore_max_extent <= 10.0))
-    return Bad("ignore_max_extent", ignore_max_extent, "must be in [0, 10] m");
-  if (split_min_points < 1) return Bad("split_min_points", split_min_points, "must be >= 1");
-  if (!(min_slant_deg >= 0.0 && min_slant_deg < 90.0))
-    return Bad("min_slant_deg", min_slant_deg, "must be in [0, 90)");
-  if (!(join_max_piece >= 0.0 && join_max_piece <= 10.0))
-    return Bad("join_max_piece", join_max_piece, "must be in [0, 10] m");
-  if (!(join_max_gap > 0.0 && join_max_gap <= 20.0))
-    return Bad("join_max_gap", join_max_gap, "must be in (0, 20] m");
-  if (!(join_max_deg >= 0.0 && join_max_deg < 90.0))
-    return Bad("join_max_deg", join_max_deg, "must be in [0, 90) deg");
-  if (!(join_max_extent >= join_max_piece && join_max_extent <= 50.0))
-    return Bad("join_max_extent", join_max_extent, "must be in [join_max_piece, 50] m");
+    return param::Problem("max_gate_margin", max_gate_margin, "m", ">= gate_margin");
+  if (!(join_max_extent >= join_max_piece))
+    return param::Problem("join_max_extent", join_max_extent, "m", ">= join_max_piece");
   return {};
 }
 

@@ -15,39 +15,9 @@ constexpr double kForbidden = 1e6;
 
 }  // namespace
 
-const char* ToString(InputMode mode) {
-  switch (mode) {
-    case InputMode::kScans: return "scans";
-    case InputMode::kBoxes: return "boxes";
-    case InputMode::kFused: return "fused";
-  }
-  return "?";
-}
-
-bool ParseInputMode(const std::string& s, InputMode* mode) {
-  if (s == "scans") *mode = InputMode::kScans;
-  else if (s == "boxes") *mode = InputMode::kBoxes;
-  else if (s == "fused") *mode = InputMode::kFused;
-  else return false;
-  return true;
-}
-
-std::string DetectionParams::FirstProblem() const {
-  std::ostringstream os;
-  auto bad = [&](const char* key, double v, const char* req) {
-    os << "detections." << key << " = " << v << ": " << req;
-    return os.str();
-  };
-  if (!(position_std > 0.0 && position_std <= 10.0)) return bad("position_std", position_std, "must be in (0, 10] m");
-  if (!(heading_std_deg > 0.0 && heading_std_deg <= 90.0))
-    return bad("heading_std_deg", heading_std_deg, "must be in (0, 90] deg");
-  if (!(gate_m > 0.0 && gate_m <= max_gate_m)) return bad("gate_m", gate_m, "must be in (0, max_gate_m] m");
-  if (!(gate_sigma >= 0.0)) return bad("gate_sigma", gate_sigma, "must be >= 0");
-  if (!(max_gate_m <= 50.0)) return bad("max_gate_m", max_gate_m, "must be <= 50 m");
-  if (!std::isfinite(min_score) && min_score != -std::numeric_limits<double>::infinity())
-    return bad("min_score", min_score, "must be a number");
-  if (std::isnan(birth_score)) return bad("birth_score", birth_score, "must be a number");
-  return "";
+std::string DetectionParams::CrossProblem() const {
+  if (!(gate_m <= max_gate_m)) return param::Problem("gate_m", gate_m, "m", "<= max_gate_m");
+  return {};
 }
 
 std::vector<BoxMeasurement> BoxesInWorld(const DetectionList& list,

@@ -31,12 +31,6 @@ void CheckKind(const MotionModel& model, const Hypothesis& h) {
 
 }  // namespace
 
-bool EkfParams::Validate(std::string* error) const {
-  return internal::CheckParam(
-      std::isfinite(gate_probability) && gate_probability > 0.0 && gate_probability < 1.0,
-      "EkfParams", "gate_probability", gate_probability, "[-]", "in (0, 1)", error);
-}
-
 const char* ToString(UpdateStatus status) {
   switch (status) {
     case UpdateStatus::kAccepted:

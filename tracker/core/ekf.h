@@ -32,15 +32,21 @@
 #include "tracker/core/ism.h"
 #include "tracker/core/motion_model.h"
 #include "tracker/core/vasm.h"
+#include "tracker/core/params.h"
 
 namespace vtrack {
 
 struct EkfParams {
-  // [-] probability that a measurement consistent with the hypothesis passes the NIS gate;
-  // the gate is the chi-square (3 dof) quantile of it (0.999 -> 16.27).
+  static constexpr const char* kSection = "ekf";
+  static constexpr const char* kAbout =
+      "The extended Kalman filter shared by both models";
   double gate_probability = 0.999;
 
-  bool Validate(std::string* error) const;
+  template <class V>
+  void Visit(V& v) {
+    v("gate_probability", &gate_probability, {"-", param::Open(0, 1), "a consistent measurement passes the NIS gate (chi-square, 3 dof: 0.999 -> 16.27)"});
+  }
+  bool Validate(std::string* error) const { return param::Validate(*this, error); }
 };
 
 enum class UpdateStatus {

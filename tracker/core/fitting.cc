@@ -20,12 +20,6 @@ constexpr double kConvergedStep = 1e-5;
 // Floor of a point's distance std [m]: keeps weights finite for a ray exactly along a face.
 constexpr double kMinPerpVar = 1e-3 * 1e-3;
 
-std::string Bad(const char* key, double value, const char* constraint) {
-  std::ostringstream os;
-  os << "fitting." << key << " = " << value << ": " << constraint;
-  return os.str();
-}
-
 double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   return a.x() * b.y() - a.y() * b.x();
 }
@@ -544,57 +538,6 @@ const char* ToString(FitFailure failure) {
     case FitFailure::kTooFewPointsInside: return "too few points inside the vehicle rectangle";
   }
   return "unknown";
-}
-
-bool FitParams::Validate(std::string* error) const {
-  std::string e;
-  if (!(min_slant_deg >= 0.0 && min_slant_deg < 45.0)) {
-    e = Bad("min_slant_deg", min_slant_deg, "must be in [0, 45)");
-  } else if (!(inlier_sigmas > 0.0 && std::isfinite(inlier_sigmas))) {
-    e = Bad("inlier_sigmas", inlier_sigmas, "must be > 0");
-  } else if (!(min_inlier_distance_m >= 0.0 && std::isfinite(min_inlier_distance_m))) {
-    e = Bad("min_inlier_distance_m", min_inlier_distance_m, "must be >= 0");
-  } else if (!(surface_std_m >= 0.0 && std::isfinite(surface_std_m))) {
-    e = Bad("surface_std_m", surface_std_m, "must be >= 0");
-  } else if (max_edge_iterations < 1) {
-    e = Bad("max_edge_iterations", max_edge_iterations, "must be >= 1");
-  } else if (max_corner_iterations < 0) {
-    e = Bad("max_corner_iterations", max_corner_iterations, "must be >= 0 (0: no corners)");
-  } else if (min_iterations < 0) {
-    e = Bad("min_iterations", min_iterations, "must be >= 0");
-  } else if (!(ransac_confidence > 0.0 && ransac_confidence < 1.0)) {
-    e = Bad("ransac_confidence", ransac_confidence, "must be in (0, 1)");
-  } else if (max_scoring_points < 8) {
-    e = Bad("max_scoring_points", max_scoring_points, "must be >= 8");
-  } else if (!(min_sample_separation_m >= 0.0 && std::isfinite(min_sample_separation_m))) {
-    e = Bad("min_sample_separation_m", min_sample_separation_m, "must be >= 0");
-  } else if (min_points < 3) {
-    e = Bad("min_points", min_points, "must be >= 3");
-  } else if (min_edge_inliers < 3) {
-    e = Bad("min_edge_inliers", min_edge_inliers, "must be >= 3");
-  } else if (!(min_second_edge_fraction >= 0.0 && min_second_edge_fraction <= 0.5)) {
-    e = Bad("min_second_edge_fraction", min_second_edge_fraction, "must be in [0, 0.5]");
-  } else if (!(min_inlier_fraction >= 0.0 && min_inlier_fraction <= 1.0)) {
-    e = Bad("min_inlier_fraction", min_inlier_fraction, "must be in [0, 1]");
-  } else if (gauss_newton_iterations < 0 || gauss_newton_iterations > 20) {
-    e = Bad("gauss_newton_iterations", gauss_newton_iterations, "must be in [0, 20]");
-  } else if (!(max_inlier_gap_m > 0.0)) {
-    e = Bad("max_inlier_gap_m", max_inlier_gap_m, "must be > 0");
-  } else if (!(max_gap_spacings >= 1.0 && std::isfinite(max_gap_spacings))) {
-    e = Bad("max_gap_spacings", max_gap_spacings, "must be >= 1");
-  } else if (!(inside_margin_m >= 0.0 && std::isfinite(inside_margin_m))) {
-    e = Bad("inside_margin_m", inside_margin_m, "must be >= 0");
-  } else if (!(partial_view_sigmas >= 0.0 && std::isfinite(partial_view_sigmas))) {
-    e = Bad("partial_view_sigmas", partial_view_sigmas, "must be >= 0");
-  } else if (!std::isfinite(variance_factor_sigmas)) {
-    e = Bad("variance_factor_sigmas", variance_factor_sigmas, "must be finite (<= 0: off)");
-  } else if (!(side_face_min_excess_m >= 0.0 && std::isfinite(side_face_min_excess_m))) {
-    e = Bad("side_face_min_excess_m", side_face_min_excess_m, "must be >= 0");
-  } else if (!(side_face_min_incidence_deg > 0.0 && side_face_min_incidence_deg <= 90.0)) {
-    e = Bad("side_face_min_incidence_deg", side_face_min_incidence_deg, "must be in (0, 90]");
-  }
-  if (!e.empty() && error) *error = e;
-  return e.empty();
 }
 
 std::array<CornerHypothesis, 3> CornerHypothesesFromPoints(const Eigen::Vector2d& p0,

@@ -7,20 +7,6 @@
 
 namespace vtrack {
 
-bool IsmParams::Validate(std::string* error) const {
-  using internal::CheckParam;
-  return CheckParam(std::isfinite(alpha) && alpha > 0.0, "IsmParams", "alpha", alpha, "[m^2/s^3]",
-                    "finite and > 0", error) &&
-         CheckParam(std::isfinite(beta) && beta > 0.0, "IsmParams", "beta", beta, "[rad^2/s^3]",
-                    "finite and > 0", error) &&
-         CheckParam(std::isfinite(initial_velocity_std) && initial_velocity_std > 0.0,
-                    "IsmParams", "initial_velocity_std", initial_velocity_std, "[m/s]",
-                    "finite and > 0", error) &&
-         CheckParam(std::isfinite(initial_yaw_rate_std) && initial_yaw_rate_std > 0.0,
-                    "IsmParams", "initial_yaw_rate_std", initial_yaw_rate_std, "[rad/s]",
-                    "finite and > 0", error);
-}
-
 IsmModel::IsmModel(const IsmParams& params) : params_(params) {
   std::string error;
   if (!params_.Validate(&error)) throw std::invalid_argument(error);

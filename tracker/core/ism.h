@@ -25,18 +25,28 @@
 #include <string>
 
 #include "tracker/core/motion_model.h"
+#include "tracker/core/params.h"
 
 namespace vtrack {
 
 struct IsmParams {
-  double alpha = 2.0;  // [m^2/s^3] spectral density of the white acceleration in x and in y (Eq. 2)
-  double beta = 0.3;   // [rad^2/s^3] spectral density of the white angular acceleration (Eq. 4)
-  // Initialisation from a single measurement (the velocity is not observed yet):
-  double initial_velocity_std = 10.0;  // [m/s] std of x_dot and of y_dot
-  double initial_yaw_rate_std = 0.5;   // [rad/s] std of theta_dot
+  static constexpr const char* kSection = "ism";
+  static constexpr const char* kAbout =
+      "Independent steering model (Section 2.1)";
+  double alpha = 2.0;
+  double beta = 0.3;
+  double initial_velocity_std = 10.0;
+  double initial_yaw_rate_std = 0.5;
 
-  // True if every field is valid; otherwise false and *error names the field and its value.
-  bool Validate(std::string* error) const;
+  template <class V>
+  void Visit(V& v) {
+    using namespace param;
+    v("alpha", &alpha, {"m^2/s^3", Above(0), "spectral density of the white acceleration in x and in y (Eq. 2)"});
+    v("beta", &beta, {"rad^2/s^3", Above(0), "spectral density of the white angular acceleration (Eq. 4)"});
+    v("initial_velocity_std", &initial_velocity_std, {"m/s", Above(0), "std of x_dot and y_dot from a single measurement (not observed yet)"});
+    v("initial_yaw_rate_std", &initial_yaw_rate_std, {"rad/s", Above(0), "std of theta_dot from a single measurement"});
+  }
+  bool Validate(std::string* error) const { return param::Validate(*this, error); }
 };
 
 class IsmModel final : public MotionModel {

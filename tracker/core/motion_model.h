@@ -86,12 +86,4 @@ class MotionModel {
   virtual Matrix6d FromIsmPriorCovariance() const = 0;
 };
 
-namespace internal {
-// For the Validate(std::string* error) of every Params struct in this library: if ok is false,
-// writes "<params>.<field> = <value> <unit>: must be <requirement>" to *error (if non-null) and
-// returns false.
-bool CheckParam(bool ok, const char* params, const char* field, double value, const char* unit,
-                const char* requirement, std::string* error);
-}  // namespace internal
-
 }  // namespace vtrack

@@ -6,58 +6,10 @@
 #include <sstream>
 
 namespace vtrack {
-namespace {
 
-std::string Bad(const char* key, double value, const char* constraint) {
-  std::ostringstream os;
-  os << "preprocess." << key << " = " << value << ": " << constraint;
-  return os.str();
-}
-
-}  // namespace
-
-const char* ToString(PreprocessParams::Ground g) {
-  switch (g) {
-    case PreprocessParams::Ground::kNone: return "none";
-    case PreprocessParams::Ground::kBand: return "band";
-    case PreprocessParams::Ground::kGrid: return "grid";
-  }
-  return "?";
-}
-
-bool ParseGround(const std::string& s, PreprocessParams::Ground* g) {
-  if (s == "none") *g = PreprocessParams::Ground::kNone;
-  else if (s == "band") *g = PreprocessParams::Ground::kBand;
-  else if (s == "grid") *g = PreprocessParams::Ground::kGrid;
-  else return false;
-  return true;
-}
-
-bool PreprocessParams::Validate(std::string* error) const {
-  const std::string e = FirstProblem();
-  if (!e.empty() && error) *error = e;
-  return e.empty();
-}
-
-std::string PreprocessParams::FirstProblem() const {
-  if (!(min_range >= 0.0)) return Bad("min_range", min_range, "must be >= 0");
-  if (!(max_range > min_range)) return Bad("max_range", max_range, "must be > min_range");
-  if (max_range > 1000.0) return Bad("max_range", max_range, "must be <= 1000");
-  if (ground_min_rings < 1) return Bad("ground_min_rings", ground_min_rings, "must be >= 1");
-  if (!std::isfinite(ground_height_body))
-    return Bad("ground_height_body", ground_height_body, "must be finite");
-  if (!(max_height > min_height)) return Bad("max_height", max_height, "must be > min_height");
-  if (!std::isfinite(min_height)) return Bad("min_height", min_height, "must be finite");
-  if (!(ground_cell >= 0.1 && ground_cell <= 10.0))
-    return Bad("ground_cell", ground_cell, "must be in [0.1, 10]");
-  if (!(ground_tolerance >= 0.0)) return Bad("ground_tolerance", ground_tolerance, "must be >= 0");
-  if (!(ground_max_slope >= 0.0 && ground_max_slope <= 1.0))
-    return Bad("ground_max_slope", ground_max_slope, "must be in [0, 1]");
-  if (!(ground_max_grade > 0.0 && ground_max_grade <= 10.0))
-    return Bad("ground_max_grade", ground_max_grade, "must be in (0, 10]");
-  if (knot_us < 10 || knot_us > 100000)
-    return Bad("knot_us", static_cast<double>(knot_us), "must be in [10, 100000]");
-  if (max_points < 1) return Bad("max_points", static_cast<double>(max_points), "must be >= 1");
+std::string PreprocessParams::CrossProblem() const {
+  if (!(max_range > min_range)) return param::Problem("max_range", max_range, "m", "> min_range");
+  if (!(max_height > min_height)) return param::Problem("max_height", max_height, "m", "> min_height");
   return {};
 }
 

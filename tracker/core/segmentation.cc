@@ -6,33 +6,10 @@
 #include <sstream>
 
 namespace vtrack {
-namespace {
-
-std::string Bad(const char* key, double value, const char* constraint) {
-  std::ostringstream os;
-  os << "segmentation." << key << " = " << value << ": " << constraint;
-  return os.str();
-}
-
-}  // namespace
-
-bool SegmentationParams::Validate(std::string* error) const {
-  const std::string e = FirstProblem();
-  if (!e.empty() && error) *error = e;
-  return e.empty();
-}
-
-std::string SegmentationParams::FirstProblem() const {
-  if (!(jump_abs > 0.0)) return Bad("jump_abs", jump_abs, "must be > 0");
-  if (!(jump_rel >= 0.0 && jump_rel < 1.0)) return Bad("jump_rel", jump_rel, "must be in [0, 1)");
-  if (!(cell_size >= 0.05 && cell_size <= 5.0))
-    return Bad("cell_size", cell_size, "must be in [0.05, 5]");
-  if (connectivity != 4 && connectivity != 8)
-    return Bad("connectivity", connectivity, "must be 4 or 8");
-  if (!(grid_radius > 0.0 && grid_radius / cell_size <= 4000.0))
-    return Bad("grid_radius", grid_radius, "must be > 0 and at most 4000 cells");
-  if (min_points < 1) return Bad("min_points", min_points, "must be >= 1");
-  if (!(max_extent > 0.0)) return Bad("max_extent", max_extent, "must be > 0");
+std::string SegmentationParams::CrossProblem() const {
+  if (connectivity != 4 && connectivity != 8) return param::Problem("connectivity", connectivity, "-", "4 or 8");
+  if (grid_radius / cell_size > 4000.0)
+    return param::Problem("grid_radius", grid_radius, "m", "at most 4000 cells of cell_size");
   return {};
 }
 

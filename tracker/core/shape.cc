@@ -8,28 +8,12 @@
 
 namespace vtrack {
 
-bool ShapeParams::Validate(std::string* error) const {
-  using internal::CheckParam;
-  return CheckParam(std::isfinite(half_life) && half_life > 0.0, "ShapeParams", "half_life",
-                    half_life, "[s]", "finite and > 0", error) &&
-         CheckParam(std::isfinite(bin_width) && bin_width > 0.0, "ShapeParams", "bin_width",
-                    bin_width, "[m]", "finite and > 0", error) &&
-         CheckParam(std::isfinite(max_dimension) && max_dimension >= 2.0 * bin_width &&
-                        max_dimension <= 1e5 * bin_width,
-                    "ShapeParams", "max_dimension", max_dimension, "[m]",
-                    "finite and between 2 and 1e5 bin widths", error) &&
-         CheckParam(std::isfinite(excluded_fraction) && excluded_fraction >= 0.0 &&
-                        excluded_fraction < 1.0,
-                    "ShapeParams", "excluded_fraction", excluded_fraction, "[-]", "in [0, 1)",
-                    error) &&
-         CheckParam(std::isfinite(smoothing_std) && smoothing_std >= 0.0 &&
-                        smoothing_std <= 100.0 * bin_width,
-                    "ShapeParams", "smoothing_std", smoothing_std, "[m]",
-                    "finite and between 0 and 100 bin widths", error) &&
-         CheckParam(std::isfinite(min_peak_fraction) && min_peak_fraction > 0.0 &&
-                        min_peak_fraction <= 1.0,
-                    "ShapeParams", "min_peak_fraction", min_peak_fraction, "[-]", "in (0, 1]",
-                    error);
+std::string ShapeParams::CrossProblem() const {
+  if (!(max_dimension >= 2.0 * bin_width && max_dimension <= 1e5 * bin_width))
+    return param::Problem("max_dimension", max_dimension, "m", "between 2 and 1e5 bin widths");
+  if (!(smoothing_std <= 100.0 * bin_width))
+    return param::Problem("smoothing_std", smoothing_std, "m", "at most 100 bin widths");
+  return {};
 }
 
 DimensionHistogram::DimensionHistogram(const ShapeParams& params) : params_(params) {

@@ -20,107 +20,21 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // still occupy about a LADAR footprint.
 constexpr double kMinObservedExtent = 0.1;  // [m]
 
-bool Check(bool ok, const char* field, double value, const char* unit, const char* requirement,
-           std::string* error) {
-  return internal::CheckParam(ok, "manager", field, value, unit, requirement, error);
-}
-
 }  // namespace
 
-const char* ToString(TrackerMode mode) {
-  switch (mode) {
-    case TrackerMode::kMht: return "mht";
-    case TrackerMode::kIsm: return "ism";
-    case TrackerMode::kVasm: return "vasm";
-  }
-  return "?";
-}
-
-bool ParseTrackerMode(const std::string& s, TrackerMode* mode) {
-  if (s == "mht") *mode = TrackerMode::kMht;
-  else if (s == "ism") *mode = TrackerMode::kIsm;
-  else if (s == "vasm") *mode = TrackerMode::kVasm;
-  else return false;
-  return true;
-}
-
-bool TrackManagerParams::Validate(std::string* error) const {
-  const auto& p = *this;
-  if (!Check(p.max_hypotheses >= 1 && p.max_hypotheses <= 4, "max_hypotheses", p.max_hypotheses,
-             "", "in [1, 4]", error) ||
-      !Check(static_cast<int>(p.vasm_variants.size()) >= p.max_hypotheses - 1, "vasm_variants",
-             static_cast<double>(p.vasm_variants.size()), "entries", "at least max_hypotheses - 1",
-             error) ||
-      !Check(p.ism_inside_fraction >= 0 && p.ism_inside_fraction <= 1, "ism_inside_fraction",
-             p.ism_inside_fraction, "", "in [0, 1]", error) ||
-      !Check(p.mover_confidence > 0 && p.mover_confidence < 1, "mover_confidence",
-             p.mover_confidence, "", "in (0, 1)", error) ||
-      !Check(p.mover_min_speed >= 0, "mover_min_speed", p.mover_min_speed, "m/s", ">= 0", error) ||
-      !Check(p.mover_scans >= 1, "mover_scans", p.mover_scans, "", ">= 1", error) ||
-      !Check(p.ambiguity_deg >= 0 && p.ambiguity_deg <= 45, "ambiguity_deg", p.ambiguity_deg,
-             "deg", "in [0, 45]", error) ||
-      !Check(p.axis_swap_ratio >= 1, "axis_swap_ratio", p.axis_swap_ratio, "", ">= 1", error) ||
-      !Check(p.score_window >= 1, "score_window", p.score_window, "", ">= 1", error) ||
-      !Check(p.switch_margin >= 0, "switch_margin", p.switch_margin, "", ">= 0", error) ||
-      !Check(p.fail_misses >= 1, "fail_misses", p.fail_misses, "", ">= 1", error) ||
-      !Check(p.confirm_updates >= 1, "confirm_updates", p.confirm_updates, "", ">= 1", error) ||
-      !Check(p.tentative_max_misses >= 1, "tentative_max_misses", p.tentative_max_misses, "",
-             ">= 1", error) ||
-      !Check(p.coast_max_s > 0, "coast_max_s", p.coast_max_s, "s", "> 0", error) ||
-      !Check(p.parked_coast_max_s > 0, "parked_coast_max_s", p.parked_coast_max_s, "s", "> 0",
-             error) ||
-      !Check(p.max_position_std > 0, "max_position_std", p.max_position_std, "m", "> 0", error) ||
-      !Check(p.duplicate_overlap > 0 && p.duplicate_overlap <= 1, "duplicate_overlap",
-             p.duplicate_overlap, "", "in (0, 1]", error) ||
-      !Check(p.range_sigma > 0 && std::isfinite(p.range_sigma), "range_sigma", p.range_sigma, "m",
-             "> 0", error) ||
-      !Check(p.fit_contour_deg >= 0 && p.fit_contour_deg <= 10, "fit_contour_deg",
-             p.fit_contour_deg, "deg", "in [0, 10]", error) ||
-      !Check(p.contour_support_height >= 0 && p.contour_support_height <= 2,
-             "contour_support_height", p.contour_support_height, "m", "in [0, 2]", error) ||
-      !Check(p.contour_support_range > 0 && p.contour_support_range <= 2, "contour_support_range",
-             p.contour_support_range, "m", "in (0, 2]", error) ||
-      !Check(p.contour_arc_span >= 0, "contour_arc_span", p.contour_arc_span, "m", ">= 0",
-             error) ||
-      !Check(p.outline_min_slant_deg >= 0 && p.outline_min_slant_deg < 45,
-             "outline_min_slant_deg", p.outline_min_slant_deg, "deg", "in [0, 45)", error) ||
-      !Check(p.outline_min_points >= 3, "outline_min_points", p.outline_min_points, "", ">= 3",
-             error) ||
-      !Check(p.outline_min_edge_inliers >= 3 && p.outline_min_edge_inliers <= p.outline_min_points,
-             "outline_min_edge_inliers", p.outline_min_edge_inliers, "",
-             "in [3, outline_min_points]", error) ||
-      !Check(p.default_length > 0 && p.default_length <= 30, "default_length", p.default_length,
-             "m", "in (0, 30]", error) ||
-      !Check(p.default_width > 0 && p.default_width <= 10, "default_width", p.default_width, "m",
-             "in (0, 10]", error) ||
-      !Check(p.default_dimension_std >= 0, "default_dimension_std", p.default_dimension_std, "m",
-             ">= 0", error) ||
-      !Check(p.small_object_extent >= 0, "small_object_extent", p.small_object_extent, "m", ">= 0",
-             error) ||
-      !Check(p.small_object_grown_extent >= p.small_object_extent, "small_object_grown_extent",
-             p.small_object_grown_extent, "m", ">= small_object_extent", error) ||
-      !Check(p.small_object_position_std > 0, "small_object_position_std",
-             p.small_object_position_std, "m", "> 0", error) ||
-      !Check(p.vehicle_max_length >= p.vehicle_min_length, "vehicle_max_length",
-             p.vehicle_max_length, "m", ">= vehicle_min_length", error) ||
-      !Check(p.vehicle_max_width >= p.vehicle_min_width, "vehicle_max_width", p.vehicle_max_width,
-             "m", ">= vehicle_min_width", error) ||
-      !Check(p.prediction_horizon_s >= 0 && p.prediction_horizon_s <= 30, "prediction_horizon_s",
-             p.prediction_horizon_s, "s", "in [0, 30]", error) ||
-      !Check(p.prediction_step_s > 0 && p.prediction_step_s <= 1, "prediction_step_s",
-             p.prediction_step_s, "s", "in (0, 1]", error)) {
-    return false;
-  }
-  for (std::size_t i = 0; i < p.vasm_variants.size(); ++i) {
-    const auto& v = p.vasm_variants[i];
-    if (!Check(v.inside_fraction >= 0 && v.inside_fraction <= 1, "vasm_variants.inside_fraction",
-               v.inside_fraction, "", "in [0, 1]", error) ||
-        !Check(v.noise_scale > 0 && v.noise_scale <= 100, "vasm_variants.noise_scale",
-               v.noise_scale, "", "in (0, 100]", error)) {
-      return false;
-    }
-  }
-  return true;
+std::string TrackManagerParams::CrossProblem() const {
+  using param::Problem;
+  if (static_cast<int>(vasm_variants.size()) < max_hypotheses - 1)
+    return Problem("vasm_variants", vasm_variants.size(), "entries", "at least max_hypotheses - 1");
+  if (outline_min_edge_inliers > outline_min_points)
+    return Problem("outline_min_edge_inliers", outline_min_edge_inliers, "-", "<= outline_min_points");
+  if (!(small_object_grown_extent >= small_object_extent))
+    return Problem("small_object_grown_extent", small_object_grown_extent, "m", ">= small_object_extent");
+  if (!(vehicle_max_length >= vehicle_min_length))
+    return Problem("vehicle_max_length", vehicle_max_length, "m", ">= vehicle_min_length");
+  if (!(vehicle_max_width >= vehicle_min_width))
+    return Problem("vehicle_max_width", vehicle_max_width, "m", ">= vehicle_min_width");
+  return {};
 }
 
 TrackManager::TrackManager(const TrackManagerParams& params, const Ekf& ekf,

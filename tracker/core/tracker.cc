@@ -39,33 +39,14 @@ GrazingJoinParams GrazingJoinParamsOf(const AssociationParams& a) {
 
 }  // namespace
 
-bool InputParams::Validate(std::string* error) const {
-  auto check = [&](bool ok, const char* field, double value, const char* unit, const char* req) {
-    return internal::CheckParam(ok, "input", field, value, unit, req, error);
-  };
-  return check(max_pose_wait_us >= 0, "max_pose_wait_us", static_cast<double>(max_pose_wait_us),
-               "us", ">= 0") &&
-         check(max_extrapolation_us >= 0, "max_extrapolation_us",
-               static_cast<double>(max_extrapolation_us), "us", ">= 0") &&
-         check(time_jump_reset_us > 0, "time_jump_reset_us",
-               static_cast<double>(time_jump_reset_us), "us", "> 0") &&
-         check(max_queued_scans >= 1, "max_queued_scans", max_queued_scans, "", ">= 1") &&
-         check(pose_history_us >= 1'000'000, "pose_history_us",
-               static_cast<double>(pose_history_us), "us", ">= 1000000") &&
-         check(max_sweep_duration_us > 0, "max_sweep_duration_us",
-               static_cast<double>(max_sweep_duration_us), "us", "> 0");
-}
-
 bool TrackerParams::Validate(std::string* error) const {
-  auto local = [&](const std::string& e) {
-    if (!e.empty() && error) *error = e;
-    return e.empty();
-  };
-  return input.Validate(error) && local(preprocess.FirstProblem()) &&
-         local(detections.FirstProblem()) &&
-         local(segmentation.FirstProblem()) && local(association.FirstProblem()) &&
-         fit.Validate(error) && ism.Validate(error) && vasm.Validate(error) &&
-         ekf.Validate(error) && shape.Validate(error) && manager.Validate(error);
+  std::string problem;
+  TrackerParams copy = *this;  // VisitSections hands out mutable pointers
+  copy.VisitSections([&](auto* section) {
+    if (problem.empty()) problem = param::FirstProblem(*section);
+  });
+  if (!problem.empty() && error != nullptr) *error = problem;
+  return problem.empty();
 }
 
 Tracker::Tracker(const TrackerParams& params, bool debug)

@@ -49,20 +49,6 @@ double SincDerivative(double a) {
   return (a * std::cos(a) - std::sin(a)) / (a * a);
 }
 
-bool VasmParams::Validate(std::string* error) const {
-  using internal::CheckParam;
-  return CheckParam(std::isfinite(alpha) && alpha > 0.0, "VasmParams", "alpha", alpha,
-                    "[m^2/s^3]", "finite and > 0", error) &&
-         CheckParam(std::isfinite(gamma) && gamma > 0.0, "VasmParams", "gamma", gamma,
-                    "[rad^2/s^3]", "finite and > 0", error) &&
-         CheckParam(std::isfinite(epsilon_L) && epsilon_L >= 0.0, "VasmParams", "epsilon_L",
-                    epsilon_L, "[m^2/s]", "finite and >= 0", error) &&
-         CheckParam(std::isfinite(initial_L) && std::abs(initial_L) <= 20.0, "VasmParams",
-                    "initial_L", initial_L, "[m]", "finite and within [-20, 20]", error) &&
-         CheckParam(std::isfinite(initial_L_std) && initial_L_std > 0.0, "VasmParams",
-                    "initial_L_std", initial_L_std, "[m]", "finite and > 0", error);
-}
-
 VasmModel::VasmModel(const VasmParams& params) : params_(params) {
   std::string error;
   if (!params_.Validate(&error)) throw std::invalid_argument(error);

@@ -470,6 +470,7 @@ TEST(Fitting, SingleEdgeCovarianceMatchesMonteCarlo) {
 TEST(Fitting, GaussNewtonReachesTheEq16Minimum) {
   std::mt19937 rng(51);
   FitParams params;
+  params.gauss_newton_iterations = 10;  // iterated to convergence (the tracker takes one step)
   SegmentFitter fitter(params);
   int checked = 0;
   for (int t = 0; t < 50; ++t) {
@@ -580,6 +581,10 @@ std::vector<double> NewObjectExtentZ2(std::uint32_t seed, bool outliers) {
   std::mt19937 rng(seed);
   FitParams params;
   params.surface_std_m = 0.0;
+  // Characterised with Gauss-Newton to convergence and a 1 m inlier gap: the tracker's 0.5 m
+  // (parked rows) cuts one of these 200 faces, sparsely sampled far away, and turns its heading.
+  params.gauss_newton_iterations = 10;
+  params.max_inlier_gap_m = 1.0;
   SegmentFitter fitter(params);
   int checked = 0;
   std::vector<double> z2;
@@ -841,28 +846,28 @@ TEST(Fitting, ParamsValidationNamesTheKey) {
     const char* key;
   };
   const Case cases[] = {
-      {[](FitParams* p) { p->min_slant_deg = 50; }, "fitting.min_slant_deg = 50"},
-      {[](FitParams* p) { p->inlier_sigmas = 0; }, "fitting.inlier_sigmas = 0"},
-      {[](FitParams* p) { p->min_inlier_distance_m = -1; }, "fitting.min_inlier_distance_m = -1"},
-      {[](FitParams* p) { p->surface_std_m = NAN; }, "fitting.surface_std_m = nan"},
-      {[](FitParams* p) { p->max_edge_iterations = 0; }, "fitting.max_edge_iterations = 0"},
-      {[](FitParams* p) { p->max_corner_iterations = -1; }, "fitting.max_corner_iterations = -1"},
-      {[](FitParams* p) { p->min_iterations = -1; }, "fitting.min_iterations = -1"},
-      {[](FitParams* p) { p->ransac_confidence = 1; }, "fitting.ransac_confidence = 1"},
-      {[](FitParams* p) { p->max_scoring_points = 2; }, "fitting.max_scoring_points = 2"},
-      {[](FitParams* p) { p->min_sample_separation_m = -0.1; }, "fitting.min_sample_separation_m = -0.1"},
-      {[](FitParams* p) { p->min_points = 2; }, "fitting.min_points = 2"},
-      {[](FitParams* p) { p->min_edge_inliers = 2; }, "fitting.min_edge_inliers = 2"},
-      {[](FitParams* p) { p->min_second_edge_fraction = 0.6; }, "fitting.min_second_edge_fraction = 0.6"},
-      {[](FitParams* p) { p->min_inlier_fraction = 2; }, "fitting.min_inlier_fraction = 2"},
-      {[](FitParams* p) { p->gauss_newton_iterations = -1; }, "fitting.gauss_newton_iterations = -1"},
-      {[](FitParams* p) { p->max_inlier_gap_m = 0; }, "fitting.max_inlier_gap_m = 0"},
-      {[](FitParams* p) { p->max_gap_spacings = 0.5; }, "fitting.max_gap_spacings = 0.5"},
-      {[](FitParams* p) { p->inside_margin_m = -1; }, "fitting.inside_margin_m = -1"},
-      {[](FitParams* p) { p->partial_view_sigmas = -1; }, "fitting.partial_view_sigmas = -1"},
-      {[](FitParams* p) { p->variance_factor_sigmas = INFINITY; }, "fitting.variance_factor_sigmas = inf"},
-      {[](FitParams* p) { p->side_face_min_excess_m = -1; }, "fitting.side_face_min_excess_m = -1"},
-      {[](FitParams* p) { p->side_face_min_incidence_deg = 0; }, "fitting.side_face_min_incidence_deg = 0"},
+      {[](FitParams* p) { p->min_slant_deg = 50; }, "fit.min_slant_deg = 50"},
+      {[](FitParams* p) { p->inlier_sigmas = 0; }, "fit.inlier_sigmas = 0"},
+      {[](FitParams* p) { p->min_inlier_distance_m = -1; }, "fit.min_inlier_distance_m = -1"},
+      {[](FitParams* p) { p->surface_std_m = NAN; }, "fit.surface_std_m = nan"},
+      {[](FitParams* p) { p->max_edge_iterations = 0; }, "fit.max_edge_iterations = 0"},
+      {[](FitParams* p) { p->max_corner_iterations = -1; }, "fit.max_corner_iterations = -1"},
+      {[](FitParams* p) { p->min_iterations = -1; }, "fit.min_iterations = -1"},
+      {[](FitParams* p) { p->ransac_confidence = 1; }, "fit.ransac_confidence = 1"},
+      {[](FitParams* p) { p->max_scoring_points = 2; }, "fit.max_scoring_points = 2"},
+      {[](FitParams* p) { p->min_sample_separation_m = -0.1; }, "fit.min_sample_separation_m = -0.1"},
+      {[](FitParams* p) { p->min_points = 2; }, "fit.min_points = 2"},
+      {[](FitParams* p) { p->min_edge_inliers = 2; }, "fit.min_edge_inliers = 2"},
+      {[](FitParams* p) { p->min_second_edge_fraction = 0.6; }, "fit.min_second_edge_fraction = 0.6"},
+      {[](FitParams* p) { p->min_inlier_fraction = 2; }, "fit.min_inlier_fraction = 2"},
+      {[](FitParams* p) { p->gauss_newton_iterations = -1; }, "fit.gauss_newton_iterations = -1"},
+      {[](FitParams* p) { p->max_inlier_gap_m = 0; }, "fit.max_inlier_gap_m = 0"},
+      {[](FitParams* p) { p->max_gap_spacings = 0.5; }, "fit.max_gap_spacings = 0.5"},
+      {[](FitParams* p) { p->inside_margin_m = -1; }, "fit.inside_margin_m = -1"},
+      {[](FitParams* p) { p->partial_view_sigmas = -1; }, "fit.partial_view_sigmas = -1"},
+      {[](FitParams* p) { p->variance_factor_sigmas = INFINITY; }, "fit.variance_factor_sigmas = inf"},
+      {[](FitParams* p) { p->side_face_min_excess_m = -1; }, "fit.side_face_min_excess_m = -1"},
+      {[](FitParams* p) { p->side_face_min_incidence_deg = 0; }, "fit.side_face_min_incidence_deg = 0"},
   };
   std::string error;
   EXPECT_TRUE(FitParams().Validate(&error));

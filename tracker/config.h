@@ -8,7 +8,7 @@
 #include <ostream>
 #include <string>
 
-#include "tracker/core/tracker_params.h"
+#include "tracker/core/parameters.h"
 
 namespace vtrack {
 

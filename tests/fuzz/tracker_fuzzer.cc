@@ -26,7 +26,7 @@
 
 #include "lcmtypes/util/decode.h"
 #include "tests/fuzz/tracker_program.h"
-#include "tracker/core/tracker_params.h"
+#include "tracker/core/parameters.h"
 #include "tracker/tracker_node.h"
 #include "vtrack/ladar_scan_t.hpp"
 #include "vtrack/pose_t.hpp"

@@ -21,7 +21,7 @@
 
 #include "lcmtypes/util/decode.h"
 #include "sensor_driver/driver/sim_cli.h"
-#include "tracker/core/tracker_params.h"
+#include "tracker/core/parameters.h"
 #include "tracker/tracker_node.h"
 #include "vtrack/ladar_scan_t.hpp"
 #include "vtrack/pose_t.hpp"

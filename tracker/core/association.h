@@ -38,61 +38,9 @@
 #include "base/box.h"
 #include "tracker/core/preprocess.h"
 #include "tracker/core/segmentation.h"
-#include "tracker/core/params.h"
+#include "tracker/core/parameters.h"
 
 namespace vtrack {
-
-struct AssociationParams {
-  static constexpr const char* kSection = "association";
-  static constexpr const char* kAbout =
-      "Segments to tracks: gates, costs, splitting and merging, grazing pieces (Eq. 15)";
-  double gate_margin = 0.8;
-  double gate_sigma = 3.0;
-  double max_gate_margin = 4.0;
-  double min_inside_fraction = 0.3;
-  double outside_penalty = 2.0;
-  double miss_cost = 3.0;
-  double merge_fraction = 0.6;
-  double ignore_max_extent = 1.0;
-  int split_min_points = 3;
-  double min_slant_deg = 10.0;
-  // Pieces of a face seen at a grazing angle (JoinGrazingPieces): segments smaller than
-  // join_max_piece whose centroids lie within join_max_gap of each other along a line within
-  // join_max_deg of the ray are one segment, as long as it stays within join_max_extent.
-  double join_max_piece = 1.0;
-  double join_max_gap = 2.5;
-  double join_max_deg = 10.0;
-  double join_max_extent = 5.0;
-  // Columns behind a mover (PredictedObject::rear_sign) whose axis lies within 2 x join_max_deg
-  // of the ray: across the ray at most mover_column_width, and the mover with them at most
-  // mover_max_length long.
-  double mover_max_length = 12.0;
-  double mover_column_width = 0.5;
-
-  template <class V>
-  void Visit(V& v) {
-    using namespace param;
-    v("gate_margin", &gate_margin, {"m", AtLeast(0), "the predicted rectangle grown by this on every side ..."});
-    v("gate_sigma", &gate_sigma, {"-", AtLeast(0), "... plus this many predicted position standard deviations ..."});
-    v("max_gate_margin", &max_gate_margin, {"m", AtLeast(0), "... at most this (>= gate_margin)"});
-    v("min_inside_fraction", &min_inside_fraction, {"-", OpenClosed(0, 1), "share of a segment's returns inside the gate to be a candidate"});
-    v("outside_penalty", &outside_penalty, {"m", AtLeast(0), "cost per unit share of returns outside the gate"});
-    v("miss_cost", &miss_cost, {"m", Above(0), "cost of leaving a track unassigned"});
-    v("merge_fraction", &merge_fraction, {"-", OpenClosed(0, 1), "a leftover segment joins an assigned track above this share inside"});
-    v("ignore_max_extent", &ignore_max_extent, {"m", Closed(0, 10), "smaller leftovers inside a track's gate are ignored"});
-    v("split_min_points", &split_min_points, {"-", AtLeast(1), "each part of a split segment has at least this many returns"});
-    v("min_slant_deg", &min_slant_deg, {"deg", ClosedOpen(0, 90), "s of Eq. 15: faces seen more edge-on are not visible"});
-    v("join_max_piece", &join_max_piece, {"m", Closed(0, 10), "grazing pieces: bounding-box diagonal of a piece (0: no joining)"});
-    v("join_max_gap", &join_max_gap, {"m", OpenClosed(0, 20), "centroid distance of two pieces"});
-    v("join_max_deg", &join_max_deg, {"deg", ClosedOpen(0, 90), "angle between the line of two pieces and the ray"});
-    v("join_max_extent", &join_max_extent, {"m", Closed(0, 50), "bounding-box diagonal of the joined segment (>= join_max_piece)"});
-    v("mover_max_length", &mover_max_length, {"m", AtLeast(0), "a mover with the columns behind it (its side seen edge-on) at most this long"});
-    v("mover_column_width", &mover_column_width, {"m", AtLeast(0), "such a column spans at most this across the ray"});
-  }
-  // max_gate_margin >= gate_margin, join_max_extent >= join_max_piece.
-  std::string CrossProblem() const;
-  bool Validate(std::string* error) const { return param::Validate(*this, error); }
-};
 
 // What association needs to know of a track: its predicted rectangle and uncertainty.
 struct PredictedObject {

@@ -6,7 +6,7 @@
 
 #include "tracker/core/ekf.h"
 #include "tracker/core/track.h"
-#include "tracker/core/track_manager_params.h"
+#include "tracker/core/parameters.h"
 
 namespace vtrack {
 

@@ -16,7 +16,7 @@
 #include "tracker/core/association.h"
 #include "base/box.h"
 #include "tracker/core/motion_model.h"
-#include "tracker/core/params.h"
+#include "tracker/core/parameters.h"
 
 namespace vtrack {
 
@@ -33,52 +33,6 @@ struct DetectionList {
   std::int64_t utime = 0;        // [us] time the boxes describe
   std::int64_t seq = 0;          // [-]
   std::vector<Detection> boxes;
-};
-
-// What the tracker measures tracks with: the LADAR's scans (fitted outlines), a detector's
-// boxes, or both (fused: boxes update and start tracks between scans; scans drive the life
-// cycle and the reports).
-enum class InputMode { kScans, kBoxes, kFused };
-
-}  // namespace vtrack
-
-template <>
-struct vtrack::param::EnumNames<vtrack::InputMode> {
-  static constexpr std::array kNames{"scans", "boxes", "fused"};
-};
-
-namespace vtrack {
-
-inline const char* ToString(InputMode mode) { return param::NameOf(mode); }
-
-struct DetectionParams {
-  static constexpr const char* kSection = "detections";
-  static constexpr const char* kAbout =
-      "A detector's boxes: input mode and their measurement model";
-  InputMode mode = InputMode::kScans;
-  double min_score = 2.0;
-  double birth_score = 2.0;
-  double position_std = 0.25;
-  double heading_std_deg = 6.0;
-  double gate_m = 2.0;
-  double gate_sigma = 3.0;
-  double max_gate_m = 5.0;
-
-  template <class V>
-  void Visit(V& v) {
-    using namespace param;
-    v("mode", &mode, {"-", {}, "what measures tracks: scans (fitted outlines), boxes (a detector's), or both (fused)"});
-    v("min_score", &min_score, {"-", Finite(), "boxes below this score, on the detector's own scale, are not used"});
-    v("birth_score", &birth_score, {"-", Finite(), "a box starts a track only from this score on"});
-    v("position_std", &position_std, {"m", OpenClosed(0, 10), "1-sigma of a box centre along each axis"});
-    v("heading_std_deg", &heading_std_deg, {"deg", OpenClosed(0, 90), "1-sigma of a box heading (modulo 180 deg)"});
-    v("gate_m", &gate_m, {"m", Above(0), "a box farther than this (+ gate_sigma predicted position stds) from a track is not its candidate"});
-    v("gate_sigma", &gate_sigma, {"-", AtLeast(0), "predicted position stds added to gate_m"});
-    v("max_gate_m", &max_gate_m, {"m", OpenClosed(0, 50), "upper bound of the whole gate (>= gate_m)"});
-  }
-  // gate_m <= max_gate_m.
-  std::string CrossProblem() const;
-  bool Validate(std::string* error) const { return param::Validate(*this, error); }
 };
 
 // A box in the world frame, ready to measure a track.

@@ -32,22 +32,9 @@
 #include "tracker/core/ism.h"
 #include "tracker/core/motion_model.h"
 #include "tracker/core/vasm.h"
-#include "tracker/core/params.h"
+#include "tracker/core/parameters.h"
 
 namespace vtrack {
-
-struct EkfParams {
-  static constexpr const char* kSection = "ekf";
-  static constexpr const char* kAbout =
-      "The extended Kalman filter shared by both models";
-  double gate_probability = 0.999;
-
-  template <class V>
-  void Visit(V& v) {
-    v("gate_probability", &gate_probability, {"-", param::Open(0, 1), "a consistent measurement passes the NIS gate (chi-square, 3 dof: 0.999 -> 16.27)"});
-  }
-  bool Validate(std::string* error) const { return param::Validate(*this, error); }
-};
 
 enum class UpdateStatus {
   kAccepted,

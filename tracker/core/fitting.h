@@ -89,65 +89,9 @@
 #include <vector>
 
 #include "base/box.h"
-#include "tracker/core/params.h"
+#include "tracker/core/parameters.h"
 
 namespace vtrack {
-
-struct FitParams {
-  static constexpr const char* kSection = "fit";
-  static constexpr const char* kAbout =
-      "Robust edge and corner fitting (Section 3, Eqs. 15-18), RANSAC then Gauss-Newton";
-  double min_slant_deg = 10.0;
-  double inlier_sigmas = 3.0;
-  double min_inlier_distance_m = 0.03;
-  double surface_std_m = 0.02;
-  int max_edge_iterations = 100;
-  int max_corner_iterations = 200;
-  int min_iterations = 10;
-  double ransac_confidence = 0.99;
-  int max_scoring_points = 96;
-  double min_sample_separation_m = 0.2;
-  int min_points = 5;
-  int min_edge_inliers = 4;
-  double min_second_edge_fraction = 0.1;
-  double min_inlier_fraction = 0.3;
-  int gauss_newton_iterations = 1;
-  double max_inlier_gap_m = 0.5;
-  double max_gap_spacings = 5.0;
-  double inside_margin_m = 0.2;
-  double partial_view_sigmas = 2.0;
-  double variance_factor_sigmas = 3.0;
-  double side_face_min_excess_m = 0.4;
-  double side_face_min_incidence_deg = 60.0;
-
-  template <class V>
-  void Visit(V& v) {
-    using namespace param;
-    v("min_slant_deg", &min_slant_deg, {"deg", ClosedOpen(0, 45), "s of Eq. 15: least angle between a fitted face and the ray"});
-    v("inlier_sigmas", &inlier_sigmas, {"-", Above(0), "a point is an inlier within this many sigma_perp of an edge"});
-    v("min_inlier_distance_m", &min_inlier_distance_m, {"m", AtLeast(0), "floor of that inlier threshold"});
-    v("surface_std_m", &surface_std_m, {"m", AtLeast(0), "face-normal noise not explained by range noise (curved bodies)"});
-    v("max_edge_iterations", &max_edge_iterations, {"-", AtLeast(1), "cap of RANSAC iterations on 2-point edge hypotheses"});
-    v("max_corner_iterations", &max_corner_iterations, {"-", AtLeast(0), "cap of RANSAC iterations on 3-point corner hypotheses (0: no corners)"});
-    v("min_iterations", &min_iterations, {"-", AtLeast(0), "RANSAC iterations before adaptive stopping"});
-    v("ransac_confidence", &ransac_confidence, {"-", Open(0, 1), "probability of drawing one all-inlier sample"});
-    v("max_scoring_points", &max_scoring_points, {"-", AtLeast(8), "hypotheses are scored on a seeded subset of at most this many points"});
-    v("min_sample_separation_m", &min_sample_separation_m, {"m", AtLeast(0), "least distance between the sample points of an edge"});
-    v("min_points", &min_points, {"-", AtLeast(3), "segments with fewer points are not fitted"});
-    v("min_edge_inliers", &min_edge_inliers, {"-", AtLeast(3), "least inliers of each fitted edge"});
-    v("min_second_edge_fraction", &min_second_edge_fraction, {"-", Closed(0, 0.5), "each edge of a corner holds at least this share of its inliers"});
-    v("min_inlier_fraction", &min_inlier_fraction, {"-", Closed(0, 1), "least share of the segment's points that are inliers"});
-    v("gauss_newton_iterations", &gauss_newton_iterations, {"-", Closed(0, 20), "weighted Gauss-Newton steps on Eq. 16 (paper: one)"});
-    v("max_inlier_gap_m", &max_inlier_gap_m, {"m", Above(0), "inliers beyond a larger gap along an edge are dropped (parked rows: rear faces ~0.8 m apart)"});
-    v("max_gap_spacings", &max_gap_spacings, {"-", AtLeast(1), "... unless the gap is within this many median point spacings (missing returns)"});
-    v("inside_margin_m", &inside_margin_m, {"m", AtLeast(0), "the rectangle grown by this for the inside fraction"});
-    v("partial_view_sigmas", &partial_view_sigmas, {"-", AtLeast(0), "an extent shorter than the shape by more sigmas is a partial view"});
-    v("variance_factor_sigmas", &variance_factor_sigmas, {"-", Finite(), "significance for scaling R by chi^2/dof (<= 0: never)"});
-    v("side_face_min_excess_m", &side_face_min_excess_m, {"m", AtLeast(0), "new object: a single face longer than its width + this is a side ..."});
-    v("side_face_min_incidence_deg", &side_face_min_incidence_deg, {"deg", OpenClosed(0, 90), "... or one seen at a larger incidence (90: off)"});
-  }
-  bool Validate(std::string* error) const { return param::Validate(*this, error); }
-};
 
 enum class FitKind : std::int8_t { kNone = 0, kEdge = 1, kCorner = 2 };  // = track_debug FIT_*
 

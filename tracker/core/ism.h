@@ -25,29 +25,9 @@
 #include <string>
 
 #include "tracker/core/motion_model.h"
-#include "tracker/core/params.h"
+#include "tracker/core/parameters.h"
 
 namespace vtrack {
-
-struct IsmParams {
-  static constexpr const char* kSection = "ism";
-  static constexpr const char* kAbout =
-      "Independent steering model (Section 2.1)";
-  double alpha = 2.0;
-  double beta = 0.3;
-  double initial_velocity_std = 10.0;
-  double initial_yaw_rate_std = 0.5;
-
-  template <class V>
-  void Visit(V& v) {
-    using namespace param;
-    v("alpha", &alpha, {"m^2/s^3", Above(0), "spectral density of the white acceleration in x and in y (Eq. 2)"});
-    v("beta", &beta, {"rad^2/s^3", Above(0), "spectral density of the white angular acceleration (Eq. 4)"});
-    v("initial_velocity_std", &initial_velocity_std, {"m/s", Above(0), "std of x_dot and y_dot from a single measurement (not observed yet)"});
-    v("initial_yaw_rate_std", &initial_yaw_rate_std, {"rad/s", Above(0), "std of theta_dot from a single measurement"});
-  }
-  bool Validate(std::string* error) const { return param::Validate(*this, error); }
-};
 
 class IsmModel final : public MotionModel {
  public:

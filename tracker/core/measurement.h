@@ -11,7 +11,7 @@
 #include "tracker/core/fitting.h"
 #include "tracker/core/motion_model.h"
 #include "tracker/core/track.h"
-#include "tracker/core/track_manager_params.h"
+#include "tracker/core/parameters.h"
 
 namespace vtrack {
 

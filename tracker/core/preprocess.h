@@ -32,52 +32,10 @@
 #include <vector>
 
 #include "base/pose.h"
-#include "tracker/core/params.h"
+#include "tracker/core/parameters.h"
 #include "tracker/core/scan.h"
 
 namespace vtrack {
-
-struct PreprocessParams {
-  static constexpr const char* kSection = "preprocess";
-  static constexpr const char* kAbout =
-      "Ego-motion compensation of every return, range limits and ground removal";
-  enum class Ground { kNone, kBand, kGrid };
-
-  double min_range = 1.0;
-  double max_range = 80.0;
-  Ground ground = Ground::kGrid;
-  int ground_min_rings = 2;
-  double ground_height_body = 0.0;
-  double min_height = 0.25;
-  double max_height = 3.0;
-  double ground_cell = 1.0;
-  double ground_tolerance = 0.6;
-  double ground_max_slope = 0.05;
-  double ground_max_grade = 0.1;
-  std::int64_t knot_us = 1000;
-  std::int64_t max_points = 500000;
-
-  template <class V>
-  void Visit(V& v) {
-    using namespace param;
-    v("min_range", &min_range, {"m", AtLeast(0), "nearer returns are dropped (the own vehicle)"});
-    v("max_range", &max_range, {"m", OpenClosed(0, 1000), "farther returns are dropped"});
-    v("ground", &ground, {"-", {}, "ground removal of 3-D clouds: none, a body-frame band, or a local grid"});
-    v("ground_min_rings", &ground_min_rings, {"-", AtLeast(1), "ground removal only for scans with at least this many rings"});
-    v("ground_height_body", &ground_height_body, {"m", Finite(), "band method: ground plane height in the body frame"});
-    v("min_height", &min_height, {"m", Finite(), "keep returns at least this far above the local ground (kerbs, road paint)"});
-    v("max_height", &max_height, {"m", Finite(), "and at most this far (foliage and overhangs above vehicles)"});
-    v("ground_cell", &ground_cell, {"m", Closed(0.1, 10), "grid method: cell of the local ground estimate"});
-    v("ground_tolerance", &ground_tolerance, {"m", AtLeast(0), "local ground within this of the scan's ground level ..."});
-    v("ground_max_slope", &ground_max_slope, {"-", Closed(0, 1), "... plus this per metre from the sensor (slopes, pitch)"});
-    v("ground_max_grade", &ground_max_grade, {"-", OpenClosed(0, 10), "and at most this per metre above the lowest return nearby (ground hidden behind an object)"});
-    v("knot_us", &knot_us, {"us", Closed(10, 100000), "pose look-ups over the sweep, interpolated between (error (omega knot)^2/8 range)"});
-    v("max_points", &max_points, {"-", AtLeast(1), "larger scans are refused (\"huge_scan\")"});
-  }
-  // max_range > min_range, max_height > min_height.
-  std::string CrossProblem() const;
-  bool Validate(std::string* error) const { return param::Validate(*this, error); }
-};
 
 // Returns kept after preprocessing, world frame, structure of arrays.
 struct WorldPoints {
@@ -160,13 +118,4 @@ class Preprocessor {
   std::vector<std::int32_t> point_cell_;
 };
 
-}  // namespace vtrack
-
-template <>
-struct vtrack::param::EnumNames<vtrack::PreprocessParams::Ground> {
-  static constexpr std::array kNames{"none", "band", "grid"};
-};
-
-namespace vtrack {
-inline const char* ToString(PreprocessParams::Ground g) { return param::NameOf(g); }
 }  // namespace vtrack

@@ -19,37 +19,9 @@
 #include <vector>
 
 #include "tracker/core/preprocess.h"
-#include "tracker/core/params.h"
+#include "tracker/core/parameters.h"
 
 namespace vtrack {
-
-struct SegmentationParams {
-  static constexpr const char* kSection = "segmentation";
-  static constexpr const char* kAbout =
-      "Segmentation of the returns into objects: range jumps on a scan line, grid components in 3-D";
-  double jump_abs = 0.6;
-  double jump_rel = 0.02;
-  double cell_size = 0.3;
-  int connectivity = 4;
-  double grid_radius = 80.0;
-  int min_points = 3;
-  double max_extent = 25.0;
-
-  template <class V>
-  void Visit(V& v) {
-    using namespace param;
-    v("jump_abs", &jump_abs, {"m", Above(0), "scan line: a segment breaks where consecutive returns lie farther apart than this ..."});
-    v("jump_rel", &jump_rel, {"-", ClosedOpen(0, 1), "... or this fraction of the range"});
-    v("cell_size", &cell_size, {"m", Closed(0.05, 5), "3-D clouds: grid cell of the connected components"});
-    v("connectivity", &connectivity, {"-", Closed(4, 8), "grid neighbourhood, 4 or 8 (8 joins cars parked 0.6 m apart)"});
-    v("grid_radius", &grid_radius, {"m", Above(0), "half-size of the grid around the sensor (returns beyond are dropped)"});
-    v("min_points", &min_points, {"-", AtLeast(1), "smaller segments are dropped"});
-    v("max_extent", &max_extent, {"m", Above(0), "segments with a larger bounding-box diagonal (walls, buildings) are dropped"});
-  }
-  // connectivity is 4 or 8; the grid holds at most 4000 cells across.
-  std::string CrossProblem() const;
-  bool Validate(std::string* error) const { return param::Validate(*this, error); }
-};
 
 struct Segment {
   std::int32_t begin = 0;  // [-] range [begin, end) in Segments::point

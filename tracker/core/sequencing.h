@@ -22,7 +22,7 @@
 #include "tracker/core/detections.h"
 #include "base/pose.h"
 #include "tracker/core/scan.h"
-#include "tracker/core/tracker_params.h"
+#include "tracker/core/parameters.h"
 
 namespace vtrack {
 

@@ -26,35 +26,9 @@
 #include <utility>
 #include <string>
 #include <vector>
-#include "tracker/core/params.h"
+#include "tracker/core/parameters.h"
 
 namespace vtrack {
-
-struct ShapeParams {
-  static constexpr const char* kSection = "shape";
-  static constexpr const char* kAbout =
-      "Adaptive shape: decaying histograms of length and width (Section 4)";
-  double half_life = 3.0;
-  double bin_width = 0.05;
-  double max_dimension = 20.0;
-  double excluded_fraction = 0.05;
-  double smoothing_std = 0.15;
-  double min_peak_fraction = 0.25;
-
-  template <class V>
-  void Visit(V& v) {
-    using namespace param;
-    v("half_life", &half_life, {"s", Above(0), "a sample's weight halves every half_life"});
-    v("bin_width", &bin_width, {"m", OpenClosed(0, 10), "histogram bin width"});
-    v("max_dimension", &max_dimension, {"m", OpenClosed(0, 1e4), "histogram range (0, max]; larger samples are outliers, never a peak"});
-    v("excluded_fraction", &excluded_fraction, {"-", ClosedOpen(0, 1), "top share of the weight excluded as outliers"});
-    v("smoothing_std", &smoothing_std, {"m", AtLeast(0), "std of the Gaussian kernel smoothing the histogram"});
-    v("min_peak_fraction", &min_peak_fraction, {"-", OpenClosed(0, 1), "least height of a peak relative to the highest"});
-  }
-  // max_dimension spans 2 to 1e5 bins; smoothing_std at most 100 bins.
-  std::string CrossProblem() const;
-  bool Validate(std::string* error) const { return param::Validate(*this, error); }
-};
 
 // The decaying histogram of one dimension (length or width).
 class DimensionHistogram {

@@ -79,7 +79,7 @@
 #include "tracker/core/range_profile.h"
 #include "tracker/core/shape.h"
 #include "tracker/core/track.h"
-#include "tracker/core/track_manager_params.h"
+#include "tracker/core/parameters.h"
 
 namespace vtrack {
 

@@ -30,7 +30,7 @@
 #include "tracker/core/segmentation.h"
 #include "tracker/core/sequencing.h"
 #include "tracker/core/track_manager.h"
-#include "tracker/core/tracker_params.h"
+#include "tracker/core/parameters.h"
 
 namespace vtrack {
 

@@ -79,7 +79,7 @@
 #include <string>
 
 #include "tracker/core/motion_model.h"
-#include "tracker/core/params.h"
+#include "tracker/core/parameters.h"
 
 namespace vtrack {
 
@@ -87,36 +87,6 @@ namespace vtrack {
 double Sinc(double a);
 // d sinc / da = (a cos a - sin a)/a^2, 0 at a = 0; Taylor series for |a| < 0.1.
 double SincDerivative(double a);
-
-struct VasmParams {
-  static constexpr const char* kSection = "vasm";
-  static constexpr const char* kAbout =
-      "Variable-axis Ackerman steering model (Section 2.2)";
-  double alpha = 2.0;
-  double gamma = 0.3;
-  double epsilon_L = 0.01;
-  // Prior of L where a conversion cannot tell it (from an ISM state, or after turning theta),
-  // for a vehicle that drives forwards: a car's rear axle is about 1.2 m behind the centre. If
-  // the centre moves against theta (v < 0), theta most likely points to the vehicle's back, and
-  // the prior mean is -initial_L (axis ahead of the centre along theta); a reversing vehicle then
-  // starts with L of the wrong sign and has to learn it (paper Section 2.2: estimating L adapts
-  // the model to either orientation). A symmetric prior (mean 0, std 1.5 m) was tried: on the
-  // turn of motion_consistency_test, 2% of VASMs drifted to L of the wrong sign on the straight
-  // before the turn and were lost in it; with this prior none of 500 were.
-  double initial_L = -1.2;
-  double initial_L_std = 1.0;
-
-  template <class V>
-  void Visit(V& v) {
-    using namespace param;
-    v("alpha", &alpha, {"m^2/s^3", Above(0), "spectral density of the along-arc acceleration on v"});
-    v("gamma", &gamma, {"rad^2/s^3", Above(0), "spectral density of the angular acceleration"});
-    v("epsilon_L", &epsilon_L, {"m^2/s", AtLeast(0), "random-walk density of L: Q_L = epsilon_L dt"});
-    v("initial_L", &initial_L, {"m", Closed(-20, 20), "prior of L: a car's rear axle ~1.2 m behind its centre"});
-    v("initial_L_std", &initial_L_std, {"m", Above(0), "std of that prior"});
-  }
-  bool Validate(std::string* error) const { return param::Validate(*this, error); }
-};
 
 class VasmModel final : public MotionModel {
  public:

@@ -1,0 +1,531 @@
+// Every parameter of the tracker core, one struct per component, each field declared once: its
+// default is the initialiser, and the struct's Visit gives its YAML key, unit, valid range and a
+// one-line reason (params.h explains the mechanism). The components' headers describe what each
+// decides; docs/parameters.md is written from these lists; config/tracker.yaml mirrors them (one
+// YAML section per struct, kSection).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "tracker/core/params.h"
+
+namespace vtrack {
+
+// How scans and poses are sequenced (message time only, never the wall clock).
+struct InputParams {
+  static constexpr const char* kSection = "input";
+  static constexpr const char* kAbout =
+      "Sequencing of scans, poses and boxes, in message time only (never the wall clock)";
+  std::int64_t max_pose_wait_us = 200'000;
+  std::int64_t max_extrapolation_us = 300'000;
+  std::int64_t time_jump_reset_us = 1'000'000;
+  int max_queued_scans = 50;
+  std::int64_t pose_history_us = 10'000'000;
+  std::int64_t max_sweep_duration_us = 1'000'000;
+
+  template <class V>
+  void Visit(V& v) {
+    using namespace param;
+    v("max_pose_wait_us", &max_pose_wait_us, {"us", AtLeast(0), "a scan waits this long past its last return for the pose stream ..."});
+    v("max_extrapolation_us", &max_extrapolation_us, {"us", AtLeast(0), "... then the pose is extrapolated at most this far (\"pose_extrapolated\"; beyond: \"stale_pose\")"});
+    v("time_jump_reset_us", &time_jump_reset_us, {"us", Above(0), "a message this much older than the newest, confirmed by the next, resets the tracker (looped log)"});
+    v("max_queued_scans", &max_queued_scans, {"-", AtLeast(1), "scans waiting for poses; older ones are dropped (\"scan_overrun\")"});
+    v("pose_history_us", &pose_history_us, {"us", AtLeast(1'000'000), "ego poses kept"});
+    v("max_sweep_duration_us", &max_sweep_duration_us, {"us", Above(0), "longer sweeps are refused (\"bad_scan\")"});
+  }
+  bool Validate(std::string* error) const { return param::Validate(*this, error); }
+};
+
+struct PreprocessParams {
+  static constexpr const char* kSection = "preprocess";
+  static constexpr const char* kAbout =
+      "Ego-motion compensation of every return, range limits and ground removal";
+  enum class Ground { kNone, kBand, kGrid };
+
+  double min_range = 1.0;
+  double max_range = 80.0;
+  Ground ground = Ground::kGrid;
+  int ground_min_rings = 2;
+  double ground_height_body = 0.0;
+  double min_height = 0.25;
+  double max_height = 3.0;
+  double ground_cell = 1.0;
+  double ground_tolerance = 0.6;
+  double ground_max_slope = 0.05;
+  double ground_max_grade = 0.1;
+  std::int64_t knot_us = 1000;
+  std::int64_t max_points = 500000;
+
+  template <class V>
+  void Visit(V& v) {
+    using namespace param;
+    v("min_range", &min_range, {"m", AtLeast(0), "nearer returns are dropped (the own vehicle)"});
+    v("max_range", &max_range, {"m", OpenClosed(0, 1000), "farther returns are dropped"});
+    v("ground", &ground, {"-", {}, "ground removal of 3-D clouds: none, a body-frame band, or a local grid"});
+    v("ground_min_rings", &ground_min_rings, {"-", AtLeast(1), "ground removal only for scans with at least this many rings"});
+    v("ground_height_body", &ground_height_body, {"m", Finite(), "band method: ground plane height in the body frame"});
+    v("min_height", &min_height, {"m", Finite(), "keep returns at least this far above the local ground (kerbs, road paint)"});
+    v("max_height", &max_height, {"m", Finite(), "and at most this far (foliage and overhangs above vehicles)"});
+    v("ground_cell", &ground_cell, {"m", Closed(0.1, 10), "grid method: cell of the local ground estimate"});
+    v("ground_tolerance", &ground_tolerance, {"m", AtLeast(0), "local ground within this of the scan's ground level ..."});
+    v("ground_max_slope", &ground_max_slope, {"-", Closed(0, 1), "... plus this per metre from the sensor (slopes, pitch)"});
+    v("ground_max_grade", &ground_max_grade, {"-", OpenClosed(0, 10), "and at most this per metre above the lowest return nearby (ground hidden behind an object)"});
+    v("knot_us", &knot_us, {"us", Closed(10, 100000), "pose look-ups over the sweep, interpolated between (error (omega knot)^2/8 range)"});
+    v("max_points", &max_points, {"-", AtLeast(1), "larger scans are refused (\"huge_scan\")"});
+  }
+  // max_range > min_range, max_height > min_height.
+  std::string CrossProblem() const;
+  bool Validate(std::string* error) const { return param::Validate(*this, error); }
+};
+
+}  // namespace vtrack
+
+template <>
+struct vtrack::param::EnumNames<vtrack::PreprocessParams::Ground> {
+  static constexpr std::array kNames{"none", "band", "grid"};
+};
+
+namespace vtrack {
+
+inline const char* ToString(PreprocessParams::Ground g) { return param::NameOf(g); }
+
+struct SegmentationParams {
+  static constexpr const char* kSection = "segmentation";
+  static constexpr const char* kAbout =
+      "Segmentation of the returns into objects: range jumps on a scan line, grid components in 3-D";
+  double jump_abs = 0.6;
+  double jump_rel = 0.02;
+  double cell_size = 0.3;
+  int connectivity = 4;
+  double grid_radius = 80.0;
+  int min_points = 3;
+  double max_extent = 25.0;
+
+  template <class V>
+  void Visit(V& v) {
+    using namespace param;
+    v("jump_abs", &jump_abs, {"m", Above(0), "scan line: a segment breaks where consecutive returns lie farther apart than this ..."});
+    v("jump_rel", &jump_rel, {"-", ClosedOpen(0, 1), "... or this fraction of the range"});
+    v("cell_size", &cell_size, {"m", Closed(0.05, 5), "3-D clouds: grid cell of the connected components"});
+    v("connectivity", &connectivity, {"-", Closed(4, 8), "grid neighbourhood, 4 or 8 (8 joins cars parked 0.6 m apart)"});
+    v("grid_radius", &grid_radius, {"m", Above(0), "half-size of the grid around the sensor (returns beyond are dropped)"});
+    v("min_points", &min_points, {"-", AtLeast(1), "smaller segments are dropped"});
+    v("max_extent", &max_extent, {"m", Above(0), "segments with a larger bounding-box diagonal (walls, buildings) are dropped"});
+  }
+  // connectivity is 4 or 8; the grid holds at most 4000 cells across.
+  std::string CrossProblem() const;
+  bool Validate(std::string* error) const { return param::Validate(*this, error); }
+};
+
+struct AssociationParams {
+  static constexpr const char* kSection = "association";
+  static constexpr const char* kAbout =
+      "Segments to tracks: gates, costs, splitting and merging, grazing pieces (Eq. 15)";
+  double gate_margin = 0.8;
+  double gate_sigma = 3.0;
+  double max_gate_margin = 4.0;
+  double min_inside_fraction = 0.3;
+  double outside_penalty = 2.0;
+  double miss_cost = 3.0;
+  double merge_fraction = 0.6;
+  double ignore_max_extent = 1.0;
+  int split_min_points = 3;
+  double min_slant_deg = 10.0;
+  // Pieces of a face seen at a grazing angle (JoinGrazingPieces): segments smaller than
+  // join_max_piece whose centroids lie within join_max_gap of each other along a line within
+  // join_max_deg of the ray are one segment, as long as it stays within join_max_extent.
+  double join_max_piece = 1.0;
+  double join_max_gap = 2.5;
+  double join_max_deg = 10.0;
+  double join_max_extent = 5.0;
+  // Columns behind a mover (PredictedObject::rear_sign) whose axis lies within 2 x join_max_deg
+  // of the ray: across the ray at most mover_column_width, and the mover with them at most
+  // mover_max_length long.
+  double mover_max_length = 12.0;
+  double mover_column_width = 0.5;
+
+  template <class V>
+  void Visit(V& v) {
+    using namespace param;
+    v("gate_margin", &gate_margin, {"m", AtLeast(0), "the predicted rectangle grown by this on every side ..."});
+    v("gate_sigma", &gate_sigma, {"-", AtLeast(0), "... plus this many predicted position standard deviations ..."});
+    v("max_gate_margin", &max_gate_margin, {"m", AtLeast(0), "... at most this (>= gate_margin)"});
+    v("min_inside_fraction", &min_inside_fraction, {"-", OpenClosed(0, 1), "share of a segment's returns inside the gate to be a candidate"});
+    v("outside_penalty", &outside_penalty, {"m", AtLeast(0), "cost per unit share of returns outside the gate"});
+    v("miss_cost", &miss_cost, {"m", Above(0), "cost of leaving a track unassigned"});
+    v("merge_fraction", &merge_fraction, {"-", OpenClosed(0, 1), "a leftover segment joins an assigned track above this share inside"});
+    v("ignore_max_extent", &ignore_max_extent, {"m", Closed(0, 10), "smaller leftovers inside a track's gate are ignored"});
+    v("split_min_points", &split_min_points, {"-", AtLeast(1), "each part of a split segment has at least this many returns"});
+    v("min_slant_deg", &min_slant_deg, {"deg", ClosedOpen(0, 90), "s of Eq. 15: faces seen more edge-on are not visible"});
+    v("join_max_piece", &join_max_piece, {"m", Closed(0, 10), "grazing pieces: bounding-box diagonal of a piece (0: no joining)"});
+    v("join_max_gap", &join_max_gap, {"m", OpenClosed(0, 20), "centroid distance of two pieces"});
+    v("join_max_deg", &join_max_deg, {"deg", ClosedOpen(0, 90), "angle between the line of two pieces and the ray"});
+    v("join_max_extent", &join_max_extent, {"m", Closed(0, 50), "bounding-box diagonal of the joined segment (>= join_max_piece)"});
+    v("mover_max_length", &mover_max_length, {"m", AtLeast(0), "a mover with the columns behind it (its side seen edge-on) at most this long"});
+    v("mover_column_width", &mover_column_width, {"m", AtLeast(0), "such a column spans at most this across the ray"});
+  }
+  // max_gate_margin >= gate_margin, join_max_extent >= join_max_piece.
+  std::string CrossProblem() const;
+  bool Validate(std::string* error) const { return param::Validate(*this, error); }
+};
+
+struct FitParams {
+  static constexpr const char* kSection = "fit";
+  static constexpr const char* kAbout =
+      "Robust edge and corner fitting (Section 3, Eqs. 15-18), RANSAC then Gauss-Newton";
+  double min_slant_deg = 10.0;
+  double inlier_sigmas = 3.0;
+  double min_inlier_distance_m = 0.03;
+  double surface_std_m = 0.02;
+  int max_edge_iterations = 100;
+  int max_corner_iterations = 200;
+  int min_iterations = 10;
+  double ransac_confidence = 0.99;
+  int max_scoring_points = 96;
+  double min_sample_separation_m = 0.2;
+  int min_points = 5;
+  int min_edge_inliers = 4;
+  double min_second_edge_fraction = 0.1;
+  double min_inlier_fraction = 0.3;
+  int gauss_newton_iterations = 1;
+  double max_inlier_gap_m = 0.5;
+  double max_gap_spacings = 5.0;
+  double inside_margin_m = 0.2;
+  double partial_view_sigmas = 2.0;
+  double variance_factor_sigmas = 3.0;
+  double side_face_min_excess_m = 0.4;
+  double side_face_min_incidence_deg = 60.0;
+
+  template <class V>
+  void Visit(V& v) {
+    using namespace param;
+    v("min_slant_deg", &min_slant_deg, {"deg", ClosedOpen(0, 45), "s of Eq. 15: least angle between a fitted face and the ray"});
+    v("inlier_sigmas", &inlier_sigmas, {"-", Above(0), "a point is an inlier within this many sigma_perp of an edge"});
+    v("min_inlier_distance_m", &min_inlier_distance_m, {"m", AtLeast(0), "floor of that inlier threshold"});
+    v("surface_std_m", &surface_std_m, {"m", AtLeast(0), "face-normal noise not explained by range noise (curved bodies)"});
+    v("max_edge_iterations", &max_edge_iterations, {"-", AtLeast(1), "cap of RANSAC iterations on 2-point edge hypotheses"});
+    v("max_corner_iterations", &max_corner_iterations, {"-", AtLeast(0), "cap of RANSAC iterations on 3-point corner hypotheses (0: no corners)"});
+    v("min_iterations", &min_iterations, {"-", AtLeast(0), "RANSAC iterations before adaptive stopping"});
+    v("ransac_confidence", &ransac_confidence, {"-", Open(0, 1), "probability of drawing one all-inlier sample"});
+    v("max_scoring_points", &max_scoring_points, {"-", AtLeast(8), "hypotheses are scored on a seeded subset of at most this many points"});
+    v("min_sample_separation_m", &min_sample_separation_m, {"m", AtLeast(0), "least distance between the sample points of an edge"});
+    v("min_points", &min_points, {"-", AtLeast(3), "segments with fewer points are not fitted"});
+    v("min_edge_inliers", &min_edge_inliers, {"-", AtLeast(3), "least inliers of each fitted edge"});
+    v("min_second_edge_fraction", &min_second_edge_fraction, {"-", Closed(0, 0.5), "each edge of a corner holds at least this share of its inliers"});
+    v("min_inlier_fraction", &min_inlier_fraction, {"-", Closed(0, 1), "least share of the segment's points that are inliers"});
+    v("gauss_newton_iterations", &gauss_newton_iterations, {"-", Closed(0, 20), "weighted Gauss-Newton steps on Eq. 16 (paper: one)"});
+    v("max_inlier_gap_m", &max_inlier_gap_m, {"m", Above(0), "inliers beyond a larger gap along an edge are dropped (parked rows: rear faces ~0.8 m apart)"});
+    v("max_gap_spacings", &max_gap_spacings, {"-", AtLeast(1), "... unless the gap is within this many median point spacings (missing returns)"});
+    v("inside_margin_m", &inside_margin_m, {"m", AtLeast(0), "the rectangle grown by this for the inside fraction"});
+    v("partial_view_sigmas", &partial_view_sigmas, {"-", AtLeast(0), "an extent shorter than the shape by more sigmas is a partial view"});
+    v("variance_factor_sigmas", &variance_factor_sigmas, {"-", Finite(), "significance for scaling R by chi^2/dof (<= 0: never)"});
+    v("side_face_min_excess_m", &side_face_min_excess_m, {"m", AtLeast(0), "new object: a single face longer than its width + this is a side ..."});
+    v("side_face_min_incidence_deg", &side_face_min_incidence_deg, {"deg", OpenClosed(0, 90), "... or one seen at a larger incidence (90: off)"});
+  }
+  bool Validate(std::string* error) const { return param::Validate(*this, error); }
+};
+
+struct IsmParams {
+  static constexpr const char* kSection = "ism";
+  static constexpr const char* kAbout =
+      "Independent steering model (Section 2.1)";
+  double alpha = 2.0;
+  double beta = 0.3;
+  double initial_velocity_std = 10.0;
+  double initial_yaw_rate_std = 0.5;
+
+  template <class V>
+  void Visit(V& v) {
+    using namespace param;
+    v("alpha", &alpha, {"m^2/s^3", Above(0), "spectral density of the white acceleration in x and in y (Eq. 2)"});
+    v("beta", &beta, {"rad^2/s^3", Above(0), "spectral density of the white angular acceleration (Eq. 4)"});
+    v("initial_velocity_std", &initial_velocity_std, {"m/s", Above(0), "std of x_dot and y_dot from a single measurement (not observed yet)"});
+    v("initial_yaw_rate_std", &initial_yaw_rate_std, {"rad/s", Above(0), "std of theta_dot from a single measurement"});
+  }
+  bool Validate(std::string* error) const { return param::Validate(*this, error); }
+};
+
+struct VasmParams {
+  static constexpr const char* kSection = "vasm";
+  static constexpr const char* kAbout =
+      "Variable-axis Ackerman steering model (Section 2.2)";
+  double alpha = 2.0;
+  double gamma = 0.3;
+  double epsilon_L = 0.01;
+  // Prior of L where a conversion cannot tell it (from an ISM state, or after turning theta),
+  // for a vehicle that drives forwards: a car's rear axle is about 1.2 m behind the centre. If
+  // the centre moves against theta (v < 0), theta most likely points to the vehicle's back, and
+  // the prior mean is -initial_L (axis ahead of the centre along theta); a reversing vehicle then
+  // starts with L of the wrong sign and has to learn it (paper Section 2.2: estimating L adapts
+  // the model to either orientation). A symmetric prior (mean 0, std 1.5 m) was tried: on the
+  // turn of motion_consistency_test, 2% of VASMs drifted to L of the wrong sign on the straight
+  // before the turn and were lost in it; with this prior none of 500 were.
+  double initial_L = -1.2;
+  double initial_L_std = 1.0;
+
+  template <class V>
+  void Visit(V& v) {
+    using namespace param;
+    v("alpha", &alpha, {"m^2/s^3", Above(0), "spectral density of the along-arc acceleration on v"});
+    v("gamma", &gamma, {"rad^2/s^3", Above(0), "spectral density of the angular acceleration"});
+    v("epsilon_L", &epsilon_L, {"m^2/s", AtLeast(0), "random-walk density of L: Q_L = epsilon_L dt"});
+    v("initial_L", &initial_L, {"m", Closed(-20, 20), "prior of L: a car's rear axle ~1.2 m behind its centre"});
+    v("initial_L_std", &initial_L_std, {"m", Above(0), "std of that prior"});
+  }
+  bool Validate(std::string* error) const { return param::Validate(*this, error); }
+};
+
+struct EkfParams {
+  static constexpr const char* kSection = "ekf";
+  static constexpr const char* kAbout =
+      "The extended Kalman filter shared by both models";
+  double gate_probability = 0.999;
+
+  template <class V>
+  void Visit(V& v) {
+    v("gate_probability", &gate_probability, {"-", param::Open(0, 1), "a consistent measurement passes the NIS gate (chi-square, 3 dof: 0.999 -> 16.27)"});
+  }
+  bool Validate(std::string* error) const { return param::Validate(*this, error); }
+};
+
+struct ShapeParams {
+  static constexpr const char* kSection = "shape";
+  static constexpr const char* kAbout =
+      "Adaptive shape: decaying histograms of length and width (Section 4)";
+  double half_life = 3.0;
+  double bin_width = 0.05;
+  double max_dimension = 20.0;
+  double excluded_fraction = 0.05;
+  double smoothing_std = 0.15;
+  double min_peak_fraction = 0.25;
+
+  template <class V>
+  void Visit(V& v) {
+    using namespace param;
+    v("half_life", &half_life, {"s", Above(0), "a sample's weight halves every half_life"});
+    v("bin_width", &bin_width, {"m", OpenClosed(0, 10), "histogram bin width"});
+    v("max_dimension", &max_dimension, {"m", OpenClosed(0, 1e4), "histogram range (0, max]; larger samples are outliers, never a peak"});
+    v("excluded_fraction", &excluded_fraction, {"-", ClosedOpen(0, 1), "top share of the weight excluded as outliers"});
+    v("smoothing_std", &smoothing_std, {"m", AtLeast(0), "std of the Gaussian kernel smoothing the histogram"});
+    v("min_peak_fraction", &min_peak_fraction, {"-", OpenClosed(0, 1), "least height of a peak relative to the highest"});
+  }
+  // max_dimension spans 2 to 1e5 bins; smoothing_std at most 100 bins.
+  std::string CrossProblem() const;
+  bool Validate(std::string* error) const { return param::Validate(*this, error); }
+};
+
+enum class TrackerMode { kMht, kIsm, kVasm };
+
+}  // namespace vtrack
+
+template <>
+struct vtrack::param::EnumNames<vtrack::TrackerMode> {
+  static constexpr std::array kNames{"mht", "ism", "vasm"};
+};
+
+namespace vtrack {
+
+inline const char* ToString(TrackerMode mode) { return param::NameOf(mode); }
+
+struct HypothesisVariant {
+  double inside_fraction = 0.5;
+  double noise_scale = 1.0;
+
+  template <class V>
+  void Visit(V& v) {
+    using namespace param;
+    v("inside_fraction", &inside_fraction, {"-", Closed(0, 1), "required share of the returns inside the rectangle"});
+    v("noise_scale", &noise_scale, {"-", OpenClosed(0, 100), "factor on the system noise Q"});
+  }
+};
+
+struct TrackManagerParams {
+  static constexpr const char* kSection = "manager";
+  static constexpr const char* kAbout =
+      "Hypotheses, outline, life cycle, classification and prediction of each track";
+  TrackerMode mode = TrackerMode::kMht;
+  int max_hypotheses = 4;
+  double ism_inside_fraction = 0.5;
+  std::vector<HypothesisVariant> vasm_variants = {{0.5, 1.0}, {0.8, 1.0}, {0.5, 4.0}};
+  double mover_confidence = 0.999;
+  double mover_min_speed = 1.0;
+  int mover_scans = 6;
+  double ambiguity_deg = 20.0;
+  double axis_swap_ratio = 1.3;
+  int score_window = 10;
+  double switch_margin = 0.1;
+  int fail_misses = 3;
+  int confirm_updates = 3;
+  int tentative_max_misses = 2;
+  double coast_max_s = 1.5;
+  double parked_coast_max_s = 3.0;
+  double max_position_std = 4.0;
+  double duplicate_overlap = 0.5;
+  double range_sigma = 0.03;
+  double fit_contour_deg = 0.2;
+  // 3-D clouds: a return enters that outline only if another return of its bin lies within
+  // contour_support_range of its range and contour_support_height or more above or below it
+  // (it stands on a vertical face; roofs and bonnets are grazed by single rings). 0: off.
+  double contour_support_height = 0.1;
+  double contour_support_range = 0.25;
+  // ... unless no return of a segment has that support and the returns of one ring span at
+  // least this much range: one ring over a nearer object sees the top of a face, while a ring
+  // grazing a roof or bonnet hits it at one range (0: any unsupported segment).
+  double contour_arc_span = 1.0;
+  // 3-D clouds: the fit on that outline refuses faces seen at less than outline_min_slant_deg
+  // and needs outline_min_points points and outline_min_edge_inliers on an edge (the fit's own
+  // min_slant_deg, min_points and min_edge_inliers apply to single-plane scans). Each outline
+  // point stands on a vertical face, corroborated by other rings: a face seen nearly edge-on
+  // (a parked car's side passed 2 m away: 3-6 deg at 20-40 m) gives one such point per azimuth
+  // step, 1-2.5 m apart, and is all of that car in view.
+  double outline_min_slant_deg = 2.0;
+  int outline_min_points = 3;
+  int outline_min_edge_inliers = 3;
+  double default_length = 4.5;
+  double default_width = 1.8;
+  double default_dimension_std = 1.0;
+  double small_object_extent = 1.0;
+  double small_object_position_std = 0.15;
+  // A track measured by centroids (first seen small, far away) becomes a rectangle once its
+  // segment spans this much: a car's end face seen squarely spans its width, 1.6-1.9 m (2 m
+  // before: a car coming into view end-on stayed a centroid at its face, 2.25 m from its centre).
+  double small_object_grown_extent = 1.5;
+  double vehicle_min_length = 2.5;
+  double vehicle_max_length = 20.0;
+  double vehicle_min_width = 1.2;
+  double vehicle_max_width = 2.8;
+  double prediction_horizon_s = 3.0;
+  double prediction_step_s = 0.1;
+
+  template <class V>
+  void Visit(V& v) {
+    using namespace param;
+    v("mode", &mode, {"-", {}, "mht: ISM and VASM hypotheses per mover; ism or vasm: one model only"});
+    v("max_hypotheses", &max_hypotheses, {"-", Closed(1, 4), "hypotheses per mover, ISM included (paper: four)"});
+    v("ism_inside_fraction", &ism_inside_fraction, {"-", Closed(0, 1), "required inside share of the ISM hypothesis (slot 0)"});
+    v("vasm_variants", &vasm_variants, {"-", {}, "the VASM hypotheses: inside share and noise factor each (max_hypotheses - 1 used)"});
+    v("mover_confidence", &mover_confidence, {"-", Open(0, 1), "chi-square (2 dof) test of a non-zero velocity"});
+    v("mover_min_speed", &mover_min_speed, {"m/s", AtLeast(0), "and at least this speed"});
+    v("mover_scans", &mover_scans, {"-", AtLeast(1), "consecutive scans with evidence of motion make a mover"});
+    v("ambiguity_deg", &ambiguity_deg, {"deg", Closed(0, 45), "psi this close to the 45 deg diagonal: the corner is ambiguous"});
+    v("axis_swap_ratio", &axis_swap_ratio, {"-", AtLeast(1), "stationary: width > this x length turns theta by 90 deg"});
+    v("score_window", &score_window, {"-", AtLeast(1), "scans in a hypothesis' fit score"});
+    v("switch_margin", &switch_margin, {"-", AtLeast(0), "score improvement needed to change the reported hypothesis"});
+    v("fail_misses", &fail_misses, {"-", AtLeast(1), "consecutive misses that fail a hypothesis"});
+    v("confirm_updates", &confirm_updates, {"-", AtLeast(1), "updates that confirm a track"});
+    v("tentative_max_misses", &tentative_max_misses, {"-", AtLeast(1), "consecutive misses that delete a tentative track"});
+    v("coast_max_s", &coast_max_s, {"s", Above(0), "a confirmed track coasts at most this long"});
+    v("parked_coast_max_s", &parked_coast_max_s, {"s", Above(0), "... a parked one (no mover, slower than mover_min_speed) at most this long"});
+    v("max_position_std", &max_position_std, {"m", Above(0), "tracks less certain than this are deleted"});
+    v("duplicate_overlap", &duplicate_overlap, {"-", OpenClosed(0, 1), "overlap (of the smaller rectangle) that makes two tracks duplicates"});
+    v("range_sigma", &range_sigma, {"m", Above(0), "LADAR range noise for fitting (Eq. 18's sigma)"});
+    v("fit_contour_deg", &fit_contour_deg, {"deg", Closed(0, 10), "fit the nearest return per bearing bin of this width (0: all returns)"});
+    v("contour_support_height", &contour_support_height, {"m", Closed(0, 2), "3-D outline: a return needs another of its bin this far above or below ... (0: off)"});
+    v("contour_support_range", &contour_support_range, {"m", OpenClosed(0, 2), "... within this of its range (it stands on a vertical face)"});
+    v("contour_arc_span", &contour_arc_span, {"m", AtLeast(0), "unsupported segments still fitted when one ring spans this much range"});
+    v("outline_min_slant_deg", &outline_min_slant_deg, {"deg", ClosedOpen(0, 45), "3-D outline fit: least angle of a face to the ray"});
+    v("outline_min_points", &outline_min_points, {"-", AtLeast(3), "3-D outline fit: least points"});
+    v("outline_min_edge_inliers", &outline_min_edge_inliers, {"-", AtLeast(3), "3-D outline fit: least inliers of an edge (<= outline_min_points)"});
+    v("default_length", &default_length, {"m", OpenClosed(0, 30), "rectangle of a new object before any estimate (a car)"});
+    v("default_width", &default_width, {"m", OpenClosed(0, 10), "its width"});
+    v("default_dimension_std", &default_dimension_std, {"m", AtLeast(0), "spread of that default"});
+    v("small_object_extent", &small_object_extent, {"m", AtLeast(0), "smaller segments are measured by their centroid"});
+    v("small_object_position_std", &small_object_position_std, {"m", Above(0), "floor of the centroid measurement std"});
+    v("small_object_grown_extent", &small_object_grown_extent, {"m", AtLeast(0), "a centroid track becomes a rectangle once its segment spans this (a car's end face: 1.6-1.9 m)"});
+    v("vehicle_min_length", &vehicle_min_length, {"m", AtLeast(0), "class vehicle: estimated length at least this ..."});
+    v("vehicle_max_length", &vehicle_max_length, {"m", AtLeast(0), "... at most this"});
+    v("vehicle_min_width", &vehicle_min_width, {"m", AtLeast(0), "... width at least this ..."});
+    v("vehicle_max_width", &vehicle_max_width, {"m", AtLeast(0), "... at most this (road vehicles are at most 2.6 m wide)"});
+    v("prediction_horizon_s", &prediction_horizon_s, {"s", Closed(0, 30), "predicted trajectory for the planner: horizon"});
+    v("prediction_step_s", &prediction_step_s, {"s", OpenClosed(0, 1), "its step"});
+  }
+  // Enough vasm_variants; outline_min_edge_inliers <= outline_min_points; grown extent >= small
+  // extent; vehicle size windows not empty.
+  std::string CrossProblem() const;
+  bool Validate(std::string* error) const { return param::Validate(*this, error); }
+};
+
+// What the tracker measures tracks with: the LADAR's scans (fitted outlines), a detector's
+// boxes, or both (fused: boxes update and start tracks between scans; scans drive the life
+// cycle and the reports).
+enum class InputMode { kScans, kBoxes, kFused };
+
+}  // namespace vtrack
+
+template <>
+struct vtrack::param::EnumNames<vtrack::InputMode> {
+  static constexpr std::array kNames{"scans", "boxes", "fused"};
+};
+
+namespace vtrack {
+
+inline const char* ToString(InputMode mode) { return param::NameOf(mode); }
+
+struct DetectionParams {
+  static constexpr const char* kSection = "detections";
+  static constexpr const char* kAbout =
+      "A detector's boxes: input mode and their measurement model";
+  InputMode mode = InputMode::kScans;
+  double min_score = 2.0;
+  double birth_score = 2.0;
+  double position_std = 0.25;
+  double heading_std_deg = 6.0;
+  double gate_m = 2.0;
+  double gate_sigma = 3.0;
+  double max_gate_m = 5.0;
+
+  template <class V>
+  void Visit(V& v) {
+    using namespace param;
+    v("mode", &mode, {"-", {}, "what measures tracks: scans (fitted outlines), boxes (a detector's), or both (fused)"});
+    v("min_score", &min_score, {"-", Finite(), "boxes below this score, on the detector's own scale, are not used"});
+    v("birth_score", &birth_score, {"-", Finite(), "a box starts a track only from this score on"});
+    v("position_std", &position_std, {"m", OpenClosed(0, 10), "1-sigma of a box centre along each axis"});
+    v("heading_std_deg", &heading_std_deg, {"deg", OpenClosed(0, 90), "1-sigma of a box heading (modulo 180 deg)"});
+    v("gate_m", &gate_m, {"m", Above(0), "a box farther than this (+ gate_sigma predicted position stds) from a track is not its candidate"});
+    v("gate_sigma", &gate_sigma, {"-", AtLeast(0), "predicted position stds added to gate_m"});
+    v("max_gate_m", &max_gate_m, {"m", OpenClosed(0, 50), "upper bound of the whole gate (>= gate_m)"});
+  }
+  // gate_m <= max_gate_m.
+  std::string CrossProblem() const;
+  bool Validate(std::string* error) const { return param::Validate(*this, error); }
+};
+
+struct TrackerParams {
+  InputParams input;
+  PreprocessParams preprocess;
+  SegmentationParams segmentation;
+  AssociationParams association;
+  FitParams fit;
+  IsmParams ism;
+  VasmParams vasm;
+  EkfParams ekf;
+  ShapeParams shape;
+  TrackManagerParams manager;  // includes the mode (mht | ism | vasm)
+  DetectionParams detections;  // a detector's boxes: the input mode and their measurement model
+
+  // Calls v(&section) for every component, in the order of config/tracker.yaml.
+  template <class V>
+  void VisitSections(V&& v) {
+    v(&input);
+    v(&preprocess);
+    v(&segmentation);
+    v(&association);
+    v(&fit);
+    v(&ism);
+    v(&vasm);
+    v(&ekf);
+    v(&shape);
+    v(&manager);
+    v(&detections);
+  }
+
+  // True if every component is valid; otherwise false and *error names the key and its value.
+  bool Validate(std::string* error) const;
+};
+
+}  // namespace vtrack

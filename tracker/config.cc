@@ -60,7 +60,7 @@ class MapReader {
     const std::string where = prefix_ + key;
     if constexpr (std::is_enum_v<T>) {
       const std::string s = v.IsScalar() ? v.Scalar() : Scalar(v);
-      if (!param::FromName(s, value)) Fail(origin_, where, "= '" + s + "': must be " + param::Choices<T>());
+      if (!FromName(s, value)) Fail(origin_, where, "= '" + s + "': must be " + Choices<T>());
     } else if constexpr (requires { value->front().Visit(*this); }) {
       ReadList(v, where, value);
     } else {
@@ -141,7 +141,7 @@ class ValueText {
   template <class T>
   static std::string Of(T* value) {
     if constexpr (std::is_enum_v<T>) {
-      return param::NameOf(*value);
+      return NameOf(*value);
     } else if constexpr (requires { value->front().Visit(std::declval<ValueText&>()); }) {
       std::string out = "[";
       for (std::size_t i = 0; i < value->size(); ++i) {
@@ -165,7 +165,7 @@ class ValueText {
 template <class T>
 std::string ValidText(T* value, const param::Info& info) {
   if constexpr (std::is_enum_v<T>) {
-    return param::Choices<T>();
+    return Choices<T>();
   } else if constexpr (std::is_arithmetic_v<T>) {
     return info.range.ToString();
   } else {

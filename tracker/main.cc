@@ -226,11 +226,11 @@ int main(int argc, char** argv) {
         params = LoadTrackerParams(config);
       }
     }
-    if (vm.count("mode") && !param::FromName(mode, &params.manager.mode)) {
+    if (vm.count("mode") && !FromName(mode, &params.manager.mode)) {
       std::cerr << "vtrack-tracker: --mode '" << mode << "' must be mht, ism or vasm\n";
       return 2;
     }
-    if (vm.count("input-mode") && !param::FromName(input_mode, &params.detections.mode)) {
+    if (vm.count("input-mode") && !FromName(input_mode, &params.detections.mode)) {
       std::cerr << "vtrack-tracker: --input-mode '" << input_mode << "' must be scans, boxes or fused\n";
       return 2;
     }

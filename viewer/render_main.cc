@@ -196,7 +196,7 @@ int main(int argc, char** argv) {
     job.render.show_truth = !vm["hide-truth"].as<bool>();
     job.render.show_legend = !vm["no-legend"].as<bool>();
     job.render.show_grid = !vm["no-grid"].as<bool>();
-    if (!vtrack::param::FromName(ground, &job.scene.preprocess.ground)) {
+    if (!vtrack::FromName(ground, &job.scene.preprocess.ground)) {
       throw UsageError("--ground '" + ground + "': must be none, band or grid");
     }
     {

@@ -88,7 +88,7 @@ int Run(const po::variables_map& vm) {
   if (!(max_growth_mb >= 0)) throw po::error("--max-rss-growth-mb = " + std::to_string(max_growth_mb) + ": must be >= 0");
   if (!(max_slowdown >= 1)) throw po::error("--max-slowdown = " + std::to_string(max_slowdown) + ": must be >= 1");
   TrackerParams params = LoadTrackerParams(vm["config"].as<std::string>());
-  if (vm.count("mode") && !param::FromName(vm["mode"].as<std::string>(), &params.manager.mode)) {
+  if (vm.count("mode") && !FromName(vm["mode"].as<std::string>(), &params.manager.mode)) {
     throw po::error("--mode = " + vm["mode"].as<std::string>() + ": must be mht, ism or vasm");
   }
   const sim::SimCli cli = sim::ReadSimCli(vm);

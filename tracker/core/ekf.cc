@@ -31,22 +31,6 @@ void CheckKind(const MotionModel& model, const Hypothesis& h) {
 
 }  // namespace
 
-const char* ToString(UpdateStatus status) {
-  switch (status) {
-    case UpdateStatus::kAccepted:
-      return "accepted";
-    case UpdateStatus::kGated:
-      return "gated: NIS above the gate";
-    case UpdateStatus::kInvalidMeasurement:
-      return "invalid measurement: z or R not finite, or R not symmetric positive definite";
-    case UpdateStatus::kInvalidState:
-      return "invalid state: hypothesis holds non-finite values";
-    case UpdateStatus::kSingularInnovation:
-      return "innovation covariance not positive definite";
-  }
-  return "unknown";
-}
-
 void EkfPredict(const MotionModel& model, double dt, double noise_scale, Hypothesis* h) {
   CheckKind(model, *h);
   if (!std::isfinite(dt) || dt < 0.0) ThrowInvalid("EkfPredict: dt [s] must be finite and >= 0, got dt", dt);

@@ -43,7 +43,21 @@ enum class UpdateStatus {
   kInvalidState,        // the hypothesis holds non-finite values (diverged)
   kSingularInnovation,  // S = H P H^T + R is not positive definite
 };
-const char* ToString(UpdateStatus status);
+
+}  // namespace vtrack
+
+template <>
+struct vtrack::EnumNames<vtrack::UpdateStatus> {
+  static constexpr std::array kNames{
+      "accepted", "gated: NIS above the gate",
+      "invalid measurement: z or R not finite, or R not symmetric positive definite",
+      "invalid state: hypothesis holds non-finite values",
+      "innovation covariance not positive definite"};
+};
+
+namespace vtrack {
+
+inline const char* ToString(UpdateStatus status) { return NameOf(status); }
 
 struct UpdateResult {
   bool accepted = false;

@@ -905,25 +905,36 @@ Subset DrawSubset(const Context& ctx, int max_points, std::minstd_rand& rng, std
   return {sx->data(), sy->data(), srx->data(), sry->data(), S};
 }
 
+// Adaptive RANSAC: draws samples until the iterations needed for the best model so far (or the
+// cap) have passed, and at least min_iterations. try_sample(&best, &best_cost, &needed) draws
+// and scores one sample, replacing the best model and the iterations needed when it is better.
+template <class TrySample>
+Model AdaptiveRansac(int max_iterations, int min_iterations, TrySample&& try_sample) {
+  Model best;
+  double best_cost = std::numeric_limits<double>::infinity();
+  int needed = max_iterations;
+  for (int it = 0; it < max_iterations; ++it) {
+    if (it >= needed && it >= min_iterations) break;
+    try_sample(&best, &best_cost, &needed);
+  }
+  return best;
+}
+
 // RANSAC for a straight edge (2 points): the truncated quadratic cost of Eq. (16) over the
 // subset; samples whose edge the sensor cannot see (Eq. 15) are skipped.
 Model RansacEdge(const Context& ctx, const Subset& sub, const FitParams& P, double slant,
                  std::uniform_int_distribution<int>& pick, std::minstd_rand& rng) {
   const int S = sub.size;
   const double min_sep2 = P.min_sample_separation_m * P.min_sample_separation_m;
-  Model best;
-  double best_cost = std::numeric_limits<double>::infinity();
-  int needed = P.max_edge_iterations;
-  for (int it = 0; it < P.max_edge_iterations; ++it) {
-    if (it >= needed && it >= P.min_iterations) break;
+  auto try_sample = [&](Model* best, double* best_cost, int* needed) {
     const int i = pick(rng), j = pick(rng);
-    if (i == j) continue;
+    if (i == j) return;
     const Eigen::Vector2d pi = sub.P(i), pj = sub.P(j);
     const Eigen::Vector2d d = pj - pi;
-    if (d.squaredNorm() < std::max(min_sep2, 1e-18)) continue;
+    if (d.squaredNorm() < std::max(min_sep2, 1e-18)) return;
     const Eigen::Vector2d u = d.normalized();
     const Eigen::Vector2d mid = 0.5 * (pi + pj);
-    if (!EdgeVisible(mid, u, ctx.sensor, slant)) continue;
+    if (!EdgeVisible(mid, u, ctx.sensor, slant)) return;
     const Eigen::Vector2d nrm = Perp(u);
     double cost = 0.0;
     int inliers = 0;
@@ -938,16 +949,16 @@ Model RansacEdge(const Context& ctx, const Subset& sub, const FitParams& P, doub
         cost += 1.0;
       }
     }
-    if (cost < best_cost) {
-      best_cost = cost;
-      best.num_edges = 1;
-      best.c = mid;
-      best.phi = AngleOf(u);
+    if (cost < *best_cost) {
+      *best_cost = cost;
+      best->num_edges = 1;
+      best->c = mid;
+      best->phi = AngleOf(u);
       const double w = static_cast<double>(inliers) / S;
-      needed = IterationsFor(w * w, P.ransac_confidence);
+      *needed = IterationsFor(w * w, P.ransac_confidence);
     }
-  }
-  return best;
+  };
+  return AdaptiveRansac(P.max_edge_iterations, P.min_iterations, try_sample);
 }
 
 // The truncated cost of a corner over the subset, with the inliers of each edge.
@@ -980,14 +991,11 @@ double CornerCost(const Context& ctx, const Subset& sub, const Eigen::Vector2d& 
 Model RansacCorner(const Context& ctx, const Subset& sub, const FitParams& P, double slant,
                    std::uniform_int_distribution<int>& pick, std::minstd_rand& rng) {
   const int S = sub.size;
+  if (S < 3) return Model{};
   const double min_sep2 = P.min_sample_separation_m * P.min_sample_separation_m;
-  Model best;
-  double best_cost = std::numeric_limits<double>::infinity();
-  int needed = P.max_corner_iterations;
-  for (int it = 0; it < P.max_corner_iterations && S >= 3; ++it) {
-    if (it >= needed && it >= P.min_iterations) break;
+  auto try_sample = [&](Model* best, double* best_cost, int* needed) {
     const int idx[3] = {pick(rng), pick(rng), pick(rng)};
-    if (idx[0] == idx[1] || idx[1] == idx[2] || idx[0] == idx[2]) continue;
+    if (idx[0] == idx[1] || idx[1] == idx[2] || idx[0] == idx[2]) return;
     const Eigen::Vector2d q[3] = {sub.P(idx[0]), sub.P(idx[1]), sub.P(idx[2])};
     const auto hyps = CornerHypothesesFromPoints(q[0], q[1], q[2]);
     for (int k = 0; k < 3; ++k) {
@@ -1000,18 +1008,18 @@ Model RansacCorner(const Context& ctx, const Subset& sub, const FitParams& P, do
       const Eigen::Vector2d u1 = Perp(u0);
       int n0 = 0, n1 = 0;
       const double cost = CornerCost(ctx, sub, h.corner, u0, u1, &n0, &n1);
-      if (cost < best_cost) {
-        best_cost = cost;
-        best.num_edges = 2;
-        best.c = h.corner;
-        best.phi = AngleOf(u0);
+      if (cost < *best_cost) {
+        *best_cost = cost;
+        best->num_edges = 2;
+        best->c = h.corner;
+        best->phi = AngleOf(u0);
         const double wa = static_cast<double>(n0) / S, wb = static_cast<double>(n1) / S;
         // A triple is a good sample if it holds points of both edges and no outlier.
-        needed = IterationsFor(3.0 * wa * wb * (wa + wb), P.ransac_confidence);
+        *needed = IterationsFor(3.0 * wa * wb * (wa + wb), P.ransac_confidence);
       }
     }
-  }
-  return best;
+  };
+  return AdaptiveRansac(P.max_corner_iterations, P.min_iterations, try_sample);
 }
 
 // Refinement of RANSAC's models on all points, and the measurement of the chosen one.

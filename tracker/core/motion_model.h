@@ -20,6 +20,8 @@
 #include <array>
 #include <string>
 
+#include "base/enum_names.h"
+
 namespace vtrack {
 
 using Vector6d = Eigen::Matrix<double, 6, 1>;
@@ -27,7 +29,16 @@ using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
 enum class ModelKind : int { kIsm = 0, kVasm = 1 };  // same values as track_t.MODEL_*
 
-const char* ToString(ModelKind kind);
+}  // namespace vtrack
+
+template <>
+struct vtrack::EnumNames<vtrack::ModelKind> {
+  static constexpr std::array kNames{"ISM", "VASM"};
+};
+
+namespace vtrack {
+
+inline const char* ToString(ModelKind kind) { return NameOf(kind); }
 
 // One estimate of one object under one motion model.
 struct Hypothesis {

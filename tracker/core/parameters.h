@@ -85,13 +85,13 @@ struct PreprocessParams {
 }  // namespace vtrack
 
 template <>
-struct vtrack::param::EnumNames<vtrack::PreprocessParams::Ground> {
+struct vtrack::EnumNames<vtrack::PreprocessParams::Ground> {
   static constexpr std::array kNames{"none", "band", "grid"};
 };
 
 namespace vtrack {
 
-inline const char* ToString(PreprocessParams::Ground g) { return param::NameOf(g); }
+inline const char* ToString(PreprocessParams::Ground g) { return NameOf(g); }
 
 struct SegmentationParams {
   static constexpr const char* kSection = "segmentation";
@@ -323,13 +323,13 @@ enum class TrackerMode { kMht, kIsm, kVasm };
 }  // namespace vtrack
 
 template <>
-struct vtrack::param::EnumNames<vtrack::TrackerMode> {
+struct vtrack::EnumNames<vtrack::TrackerMode> {
   static constexpr std::array kNames{"mht", "ism", "vasm"};
 };
 
 namespace vtrack {
 
-inline const char* ToString(TrackerMode mode) { return param::NameOf(mode); }
+inline const char* ToString(TrackerMode mode) { return NameOf(mode); }
 
 struct HypothesisVariant {
   double inside_fraction = 0.5;
@@ -457,13 +457,13 @@ enum class InputMode { kScans, kBoxes, kFused };
 }  // namespace vtrack
 
 template <>
-struct vtrack::param::EnumNames<vtrack::InputMode> {
+struct vtrack::EnumNames<vtrack::InputMode> {
   static constexpr std::array kNames{"scans", "boxes", "fused"};
 };
 
 namespace vtrack {
 
-inline const char* ToString(InputMode mode) { return param::NameOf(mode); }
+inline const char* ToString(InputMode mode) { return NameOf(mode); }
 
 struct DetectionParams {
   static constexpr const char* kSection = "detections";

@@ -17,6 +17,8 @@
 #include <type_traits>
 #include <vector>
 
+#include "base/enum_names.h"
+
 namespace vtrack::param {
 
 // The valid values of a numeric field: an interval whose ends are open or closed; NaN never lies
@@ -63,38 +65,6 @@ inline Range Closed(double lo, double hi) { return {lo, hi, false, false}; }
 inline Range OpenClosed(double lo, double hi) { return {lo, hi, true, false}; }  // (lo, hi]
 inline Range ClosedOpen(double lo, double hi) { return {lo, hi, false, true}; }  // [lo, hi)
 inline Range Open(double lo, double hi) { return {lo, hi, true, true}; }
-
-// An enumeration's names in YAML and on the command line, in the order of its values 0, 1, ...:
-// specialise `template <> struct EnumNames<E> { static constexpr std::array kNames{...}; };`.
-template <class E>
-struct EnumNames;
-
-template <class E>
-const char* NameOf(E value) {
-  const auto& names = EnumNames<E>::kNames;
-  const auto i = static_cast<std::size_t>(value);
-  return i < names.size() ? names[i] : "?";
-}
-
-template <class E>
-bool FromName(const std::string& name, E* value) {
-  const auto& names = EnumNames<E>::kNames;
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    if (name == names[i]) {
-      *value = static_cast<E>(i);
-      return true;
-    }
-  }
-  return false;
-}
-
-// "none | band | grid".
-template <class E>
-std::string Choices() {
-  std::string out;
-  for (const char* n : EnumNames<E>::kNames) out += (out.empty() ? "" : " | ") + std::string(n);
-  return out;
-}
 
 // What a field's declaration says besides its key and default.
 struct Info {

@@ -83,8 +83,6 @@ struct UnionFind {
 std::string AssociationParams::CrossProblem() const {
   if (!(max_gate_margin >= gate_margin))
     return param::Problem("max_gate_margin", max_gate_margin, "m", ">= gate_margin");
-  if (!(join_max_extent >= join_max_piece))
-    return param::Problem("join_max_extent", join_max_extent, "m", ">= join_max_piece");
   return {};
 }
 
@@ -335,10 +333,10 @@ bool Associator::JoinMover(const std::vector<PredictedObject>& tracks, const Wor
   for (std::size_t j = 0; j < tracks.size(); ++j) {
     const PredictedObject& t = tracks[j];
     if (t.rear_sign == 0 || out->track_points[j].empty()) continue;
-    // Its side is seen edge-on only if its axis lies near the ray (within join_max_deg x 2):
+    // Its side is seen edge-on only if its axis lies near the ray (within mover_column_deg):
     // behind a crossing mover the band would be a strip across the ray, a pedestrian's place.
     if (std::abs(std::cos(t.box.theta) * ray.x() + std::sin(t.box.theta) * ray.y()) <
-        std::cos(2.0 * DegToRad(params_.join_max_deg))) {
+        std::cos(DegToRad(params_.mover_column_deg))) {
       continue;
     }
     const BoxFrame frame(t.box);

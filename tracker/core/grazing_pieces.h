@@ -15,17 +15,11 @@
 
 #include <Eigen/Core>
 
+#include "tracker/core/parameters.h"
 #include "tracker/core/preprocess.h"
 #include "tracker/core/segmentation.h"
 
 namespace vtrack {
-
-struct GrazingJoinParams {
-  double max_piece = 1.0;    // [m] bounding-box diagonal of a piece (0: no joining)
-  double max_gap = 2.5;      // [m] centroid distance of two pieces
-  double max_deg = 10.0;     // [deg] angle between the line of two pieces and the ray
-  double max_extent = 5.0;   // [m] bounding-box diagonal of the joined segment
-};
 
 // Joins the grazing pieces of *segments (returns in pts, sensor at sensor_xy). Returns the
 // number of joins.

@@ -23,19 +23,12 @@
 #include <utility>
 #include <vector>
 
+#include "tracker/core/parameters.h"
 #include "tracker/core/preprocess.h"
 #include "tracker/core/scan.h"
 #include "tracker/core/track.h"
 
 namespace vtrack {
-
-struct OutlineParams {
-  double bin_deg = 0.2;          // [deg] bearing bin of the outline; 0: every return
-  double support_height = 0.1;   // [m] 3-D: height difference that makes a vertical face; 0: off
-  double support_range = 0.25;   // [m] 3-D: range difference within which returns support
-  double arc_span = 1.0;         // [m] 3-D: one ring's range span that makes an unsupported
-                                 //     segment a face seen over something nearer (0: any)
-};
 
 class OutlineExtractor {
  public:

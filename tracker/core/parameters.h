@@ -121,6 +121,34 @@ struct SegmentationParams {
   bool Validate(std::string* error) const { return param::Validate(*this, error); }
 };
 
+// Pieces of a face seen at a grazing angle (grazing_pieces.h): segments smaller than max_piece
+// whose centroids lie within max_gap of each other along a line within max_deg of the ray are one
+// segment, as long as it stays within max_extent.
+struct GrazingJoinParams {
+  static constexpr const char* kSection = "grazing";
+  static constexpr const char* kAbout =
+      "Pieces of one face seen at a grazing angle joined into one segment";
+  double max_piece = 1.0;
+  double max_gap = 2.5;
+  double max_deg = 10.0;
+  double max_extent = 5.0;
+
+  template <class V>
+  void Visit(V& v) {
+    using namespace param;
+    v("max_piece", &max_piece, {"m", Closed(0, 10), "bounding-box diagonal of a piece (0: no joining)"});
+    v("max_gap", &max_gap, {"m", OpenClosed(0, 20), "centroid distance of two pieces (cars of a row are 3 m or more apart)"});
+    v("max_deg", &max_deg, {"deg", ClosedOpen(0, 90), "angle between the line of two pieces and the ray"});
+    v("max_extent", &max_extent, {"m", Closed(0, 50), "bounding-box diagonal of the joined segment (>= max_piece)"});
+  }
+  // max_extent >= max_piece.
+  std::string CrossProblem() const {
+    if (!(max_extent >= max_piece)) return param::Problem("max_extent", max_extent, "m", ">= max_piece");
+    return {};
+  }
+  bool Validate(std::string* error) const { return param::Validate(*this, error); }
+};
+
 struct AssociationParams {
   static constexpr const char* kSection = "association";
   static constexpr const char* kAbout =
@@ -135,16 +163,10 @@ struct AssociationParams {
   double ignore_max_extent = 1.0;
   int split_min_points = 3;
   double min_slant_deg = 10.0;
-  // Pieces of a face seen at a grazing angle (JoinGrazingPieces): segments smaller than
-  // join_max_piece whose centroids lie within join_max_gap of each other along a line within
-  // join_max_deg of the ray are one segment, as long as it stays within join_max_extent.
-  double join_max_piece = 1.0;
-  double join_max_gap = 2.5;
-  double join_max_deg = 10.0;
-  double join_max_extent = 5.0;
-  // Columns behind a mover (PredictedObject::rear_sign) whose axis lies within 2 x join_max_deg
+  // Columns behind a mover (PredictedObject::rear_sign) whose axis lies within mover_column_deg
   // of the ray: across the ray at most mover_column_width, and the mover with them at most
   // mover_max_length long.
+  double mover_column_deg = 20.0;
   double mover_max_length = 12.0;
   double mover_column_width = 0.5;
 
@@ -161,15 +183,34 @@ struct AssociationParams {
     v("ignore_max_extent", &ignore_max_extent, {"m", Closed(0, 10), "smaller leftovers inside a track's gate are ignored"});
     v("split_min_points", &split_min_points, {"-", AtLeast(1), "each part of a split segment has at least this many returns"});
     v("min_slant_deg", &min_slant_deg, {"deg", ClosedOpen(0, 90), "s of Eq. 15: faces seen more edge-on are not visible"});
-    v("join_max_piece", &join_max_piece, {"m", Closed(0, 10), "grazing pieces: bounding-box diagonal of a piece (0: no joining)"});
-    v("join_max_gap", &join_max_gap, {"m", OpenClosed(0, 20), "centroid distance of two pieces"});
-    v("join_max_deg", &join_max_deg, {"deg", ClosedOpen(0, 90), "angle between the line of two pieces and the ray"});
-    v("join_max_extent", &join_max_extent, {"m", Closed(0, 50), "bounding-box diagonal of the joined segment (>= join_max_piece)"});
-    v("mover_max_length", &mover_max_length, {"m", AtLeast(0), "a mover with the columns behind it (its side seen edge-on) at most this long"});
-    v("mover_column_width", &mover_column_width, {"m", AtLeast(0), "such a column spans at most this across the ray"});
+    v("mover_column_deg", &mover_column_deg, {"deg", ClosedOpen(0, 90), "a leftover column whose axis lies this close to the ray may be a mover's side seen edge-on ..."});
+    v("mover_max_length", &mover_max_length, {"m", AtLeast(0), "... if the mover with it stays at most this long ..."});
+    v("mover_column_width", &mover_column_width, {"m", AtLeast(0), "... and it spans at most this across the ray"});
   }
-  // max_gate_margin >= gate_margin, join_max_extent >= join_max_piece.
+  // max_gate_margin >= gate_margin.
   std::string CrossProblem() const;
+  bool Validate(std::string* error) const { return param::Validate(*this, error); }
+};
+
+// The outline a rectangle is fitted to (outline.h): per bearing bin the nearest return; in a 3-D
+// cloud only a return standing on a vertical face (roofs and bonnets are grazed by single rings).
+struct OutlineParams {
+  static constexpr const char* kSection = "outline";
+  static constexpr const char* kAbout =
+      "The outline of a segment that the rectangle is fitted to: nearest returns per bearing bin";
+  double bin_deg = 0.2;
+  double support_height = 0.1;
+  double support_range = 0.25;
+  double arc_span = 1.0;
+
+  template <class V>
+  void Visit(V& v) {
+    using namespace param;
+    v("bin_deg", &bin_deg, {"deg", Closed(0, 10), "bearing bin: the nearest return of each is fitted (0: every return); also the range profile's bin"});
+    v("support_height", &support_height, {"m", Closed(0, 2), "3-D: a return needs another of its bin this far above or below it ... (0: off)"});
+    v("support_range", &support_range, {"m", OpenClosed(0, 2), "... within this of its range (it stands on a vertical face)"});
+    v("arc_span", &arc_span, {"m", AtLeast(0), "3-D: a segment without support is still fitted when one ring spans this much range (a face's top seen over something nearer; 0: any)"});
+  }
   bool Validate(std::string* error) const { return param::Validate(*this, error); }
 };
 
@@ -366,16 +407,6 @@ struct TrackManagerParams {
   double max_position_std = 4.0;
   double duplicate_overlap = 0.5;
   double range_sigma = 0.03;
-  double fit_contour_deg = 0.2;
-  // 3-D clouds: a return enters that outline only if another return of its bin lies within
-  // contour_support_range of its range and contour_support_height or more above or below it
-  // (it stands on a vertical face; roofs and bonnets are grazed by single rings). 0: off.
-  double contour_support_height = 0.1;
-  double contour_support_range = 0.25;
-  // ... unless no return of a segment has that support and the returns of one ring span at
-  // least this much range: one ring over a nearer object sees the top of a face, while a ring
-  // grazing a roof or bonnet hits it at one range (0: any unsupported segment).
-  double contour_arc_span = 1.0;
   // 3-D clouds: the fit on that outline refuses faces seen at less than outline_min_slant_deg
   // and needs outline_min_points points and outline_min_edge_inliers on an edge (the fit's own
   // min_slant_deg, min_points and min_edge_inliers apply to single-plane scans). Each outline
@@ -423,10 +454,6 @@ struct TrackManagerParams {
     v("max_position_std", &max_position_std, {"m", Above(0), "tracks less certain than this are deleted"});
     v("duplicate_overlap", &duplicate_overlap, {"-", OpenClosed(0, 1), "overlap (of the smaller rectangle) that makes two tracks duplicates"});
     v("range_sigma", &range_sigma, {"m", Above(0), "LADAR range noise for fitting (Eq. 18's sigma)"});
-    v("fit_contour_deg", &fit_contour_deg, {"deg", Closed(0, 10), "fit the nearest return per bearing bin of this width (0: all returns)"});
-    v("contour_support_height", &contour_support_height, {"m", Closed(0, 2), "3-D outline: a return needs another of its bin this far above or below ... (0: off)"});
-    v("contour_support_range", &contour_support_range, {"m", OpenClosed(0, 2), "... within this of its range (it stands on a vertical face)"});
-    v("contour_arc_span", &contour_arc_span, {"m", AtLeast(0), "unsupported segments still fitted when one ring spans this much range"});
     v("outline_min_slant_deg", &outline_min_slant_deg, {"deg", ClosedOpen(0, 45), "3-D outline fit: least angle of a face to the ray"});
     v("outline_min_points", &outline_min_points, {"-", AtLeast(3), "3-D outline fit: least points"});
     v("outline_min_edge_inliers", &outline_min_edge_inliers, {"-", AtLeast(3), "3-D outline fit: least inliers of an edge (<= outline_min_points)"});
@@ -499,7 +526,9 @@ struct TrackerParams {
   InputParams input;
   PreprocessParams preprocess;
   SegmentationParams segmentation;
+  GrazingJoinParams grazing;
   AssociationParams association;
+  OutlineParams outline;
   FitParams fit;
   IsmParams ism;
   VasmParams vasm;
@@ -514,7 +543,9 @@ struct TrackerParams {
     v(&input);
     v(&preprocess);
     v(&segmentation);
+    v(&grazing);
     v(&association);
+    v(&outline);
     v(&fit);
     v(&ism);
     v(&vasm);

@@ -29,14 +29,6 @@ std::int64_t MaxCoastUs(const TrackManagerParams& m) {
   return static_cast<std::int64_t>(std::max(m.coast_max_s, m.parked_coast_max_s) * 1e6);
 }
 
-OutlineParams OutlineParamsOf(const TrackManagerParams& m) {
-  return {m.fit_contour_deg, m.contour_support_height, m.contour_support_range, m.contour_arc_span};
-}
-
-GrazingJoinParams GrazingJoinParamsOf(const AssociationParams& a) {
-  return {a.join_max_piece, a.join_max_gap, a.join_max_deg, a.join_max_extent};
-}
-
 }  // namespace
 
 bool TrackerParams::Validate(std::string* error) const {
@@ -56,7 +48,7 @@ Tracker::Tracker(const TrackerParams& params, bool debug)
       preprocessor_(params.preprocess),
       segmenter_(params.segmentation),
       associator_(params.association),
-      outline_(OutlineParamsOf(params.manager)),
+      outline_(params.outline),
       created_(params.association) {
   std::string error;
   if (!params_.Validate(&error)) throw std::invalid_argument(error);
@@ -159,7 +151,7 @@ bool Tracker::Process(const LadarScan& scan, bool extrapolate, ScanOutput* out) 
   out->stats = pre.stats;
   // Segmentation, then the pieces of faces seen at a grazing angle joined.
   segmenter_.Run(points_, scan.num_rings <= 1, pre.sensor_xy, &segments_);
-  JoinGrazingPieces(points_, pre.sensor_xy, GrazingJoinParamsOf(params_.association), &segments_);
+  JoinGrazingPieces(points_, pre.sensor_xy, params_.grazing, &segments_);
   out->num_segments = static_cast<std::int32_t>(segments_.segments.size());
   // Association with the tracks predicted to the middle of the sweep.
   manager_->Predict(scan.utime + scan.sweep_duration_us / 2, &predicted_);
@@ -201,7 +193,7 @@ void Tracker::UpdateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_
   const bool multi_ring = scan.num_rings > 1;
   if (multi_ring) {
     profile_.Build(sensor_xy, points_.x, points_.y, points_.ring,
-                   std::max(kMinProfileBinDeg, params_.manager.fit_contour_deg));
+                   std::max(kMinProfileBinDeg, params_.outline.bin_deg));
   }
   const std::size_t num_tracks = manager_->tracks().size();
   for (std::size_t j = 0; j < num_tracks; ++j) {

@@ -355,9 +355,13 @@ TEST(AssociatorTest, ValidateNamesTheKey) {
   EXPECT_FALSE(p.Validate(&error));
   EXPECT_NE(error.find("min_inside_fraction = 0"), std::string::npos);
   p = AssociationParams{};
-  p.join_max_gap = -1.0;
+  p.mover_column_deg = 90.0;
   EXPECT_FALSE(p.Validate(&error));
-  EXPECT_NE(error.find("join_max_gap = -1"), std::string::npos) << error;
+  EXPECT_NE(error.find("association.mover_column_deg = 90"), std::string::npos) << error;
+  GrazingJoinParams g;
+  g.max_gap = -1.0;
+  EXPECT_FALSE(g.Validate(&error));
+  EXPECT_NE(error.find("grazing.max_gap = -1"), std::string::npos) << error;
 }
 
 }  // namespace

@@ -101,7 +101,7 @@ TEST(OutlineTest, RoofLineSeenByOneRingOverANearerCarIsTracked) {
 
   // Without the one-ring rule (any range span too small) no return of the car is measured.
   TrackerParams strict = NoGroundRemoval();
-  strict.manager.contour_arc_span = 1e6;
+  strict.outline.arc_span = 1e6;
   EXPECT_EQ(Near(RunStill(RoofLine(), strict), 34.0, 1.75, 5.0), nullptr);
 }
 
@@ -111,7 +111,7 @@ TEST(OutlineTest, RingGrazingARoofAtOneRangeMakesNoTrack) {
   // The same arc with the rule off for every span (0 m) is measured: the range span is what
   // tells the two apart.
   TrackerParams loose = NoGroundRemoval();
-  loose.manager.contour_arc_span = 0.0;
+  loose.outline.arc_span = 0.0;
   EXPECT_NE(Near(RunStill(GrazedRoof(), loose), 6.13, -5.14, 10.0), nullptr);
 }
 

@@ -139,6 +139,10 @@ int RunOffline(const TrackerParams& params, const NodeOptions& options, const st
     std::fprintf(stderr, "vtrack-tracker:   rejected %-20s %lld\n", s.reject_reason[i].c_str(),
                  static_cast<long long>(s.reject_count[i]));
   }
+  if (reader.damaged()) {
+    std::fprintf(stderr, "vtrack-tracker: %s\n", reader.DamageSummary().c_str());
+    return 3;
+  }
   return 0;
 }
 

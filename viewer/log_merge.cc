@@ -42,12 +42,8 @@ std::int64_t MergedLogReader::TotalBytes() const {
 
 std::vector<std::string> MergedLogReader::IncompleteLogs() const {
   std::vector<std::string> out;
-  for (std::size_t i = 0; i < readers_.size(); ++i) {
-    const auto& r = readers_[i];
-    if (!heads_[i] && r->BytesRead() < r->FileSize()) {
-      out.push_back("log '" + r->path() + "' ended at byte " + std::to_string(r->BytesRead()) +
-                    " of " + std::to_string(r->FileSize()) + " (truncated or damaged)");
-    }
+  for (const auto& r : readers_) {
+    if (r->damaged()) out.push_back(r->DamageSummary());
   }
   return out;
 }

@@ -27,7 +27,7 @@ class MergedLogReader {
   // Bytes read so far over all logs, and their total size (for progress).
   std::int64_t BytesRead() const;
   std::int64_t TotalBytes() const;
-  // Logs that ended before their last byte (a truncated or damaged file), as messages.
+  // What was skipped of each damaged log (garbage, impossible lengths, a cut end), as messages.
   std::vector<std::string> IncompleteLogs() const;
 
  private:

@@ -262,6 +262,7 @@ int main(int argc, char** argv) {
                    static_cast<long long>(st.frames_skipped),
                    static_cast<long long>(st.late_dropped), st.wall_s,
                    static_cast<long long>(st.decode_errors));
+      if (!st.warnings.empty()) return 3;  // rendered what was whole; the input was damaged
     } else {
       const std::string url = vtrack::viewer::WithReceiveBuffer(lcm_url);
       auto lcm = vtrack::lcm_util::OpenLcm(url);

@@ -6,21 +6,117 @@
 
 namespace vtrack::lcm_util {
 
+namespace {
+
+constexpr std::uint32_t kSyncWord = 0xEDA1DA01;
+constexpr int kHeaderBytes = 4 + 8 + 8 + 4 + 4;
+// Longest channel name accepted (LCM itself allows 63 on udpm; logs from other transports may
+// hold longer ones). A header claiming more is damage.
+constexpr std::int32_t kMaxChannelBytes = 4096;
+
+std::uint64_t BigEndian(const unsigned char* p, int n) {
+  std::uint64_t v = 0;
+  for (int i = 0; i < n; ++i) v = (v << 8) | p[i];
+  return v;
+}
+
+}  // namespace
+
 LogReader::LogReader(const std::string& path) : path_(path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
     throw std::runtime_error("cannot open LCM log '" + path + "': no such file");
   }
   file_size_ = static_cast<std::int64_t>(std::filesystem::file_size(path, ec));
-  log_ = std::make_unique<lcm::LogFile>(path, "r");
-  if (!log_->good()) throw std::runtime_error("cannot open LCM log '" + path + "' for reading");
+  file_ = std::fopen(path.c_str(), "rb");
+  if (file_ == nullptr) throw std::runtime_error("cannot open LCM log '" + path + "' for reading");
 }
 
-const lcm::LogEvent* LogReader::Next() { return log_->readNextEvent(); }
+LogReader::~LogReader() {
+  if (file_ != nullptr) std::fclose(file_);
+}
 
-std::int64_t LogReader::BytesRead() const {
-  FILE* f = log_->getFilePtr();
-  return f ? static_cast<std::int64_t>(std::ftell(f)) : 0;
+bool LogReader::Seek(std::int64_t offset) {
+  return std::fseek(file_, static_cast<long>(offset), SEEK_SET) == 0;
+}
+
+bool LogReader::ReadHeader(std::int64_t* eventnum, std::int64_t* timestamp,
+                           std::int32_t* channel_len, std::int32_t* data_len) {
+  unsigned char h[kHeaderBytes];
+  if (offset_ + kHeaderBytes > file_size_ || (std::ftell(file_) != offset_ && !Seek(offset_)) ||
+      std::fread(h, 1, kHeaderBytes, file_) != kHeaderBytes) {
+    return false;
+  }
+  if (BigEndian(h, 4) != kSyncWord) return false;
+  *eventnum = static_cast<std::int64_t>(BigEndian(h + 4, 8));
+  *timestamp = static_cast<std::int64_t>(BigEndian(h + 12, 8));
+  const auto clen = static_cast<std::int32_t>(BigEndian(h + 20, 4));
+  const auto dlen = static_cast<std::int32_t>(BigEndian(h + 24, 4));
+  if (clen <= 0 || clen > kMaxChannelBytes || dlen < 0) return false;
+  if (offset_ + kHeaderBytes + clen + dlen > file_size_) return false;  // cut short
+  *channel_len = clen;
+  *data_len = dlen;
+  return true;
+}
+
+void LogReader::Resync() {
+  const std::int64_t start = offset_;
+  std::int64_t eventnum, timestamp;
+  std::int32_t clen, dlen;
+  // Search byte by byte for the sync word, then check the header that follows it.
+  std::uint32_t window = 0;
+  std::int64_t pos = start + 1;
+  Seek(pos);
+  int c;
+  while ((c = std::fgetc(file_)) != EOF) {
+    window = (window << 8) | static_cast<std::uint32_t>(c);
+    ++pos;
+    if (window != kSyncWord || pos - 4 <= start) continue;
+    offset_ = pos - 4;
+    if (ReadHeader(&eventnum, &timestamp, &clen, &dlen)) break;
+    Seek(pos);  // not an event: go on after the sync word's first byte
+    window = kSyncWord & 0x00FFFFFF;
+  }
+  if (c == EOF) offset_ = file_size_;
+  ++damage_.regions;
+  damage_.bytes_skipped += offset_ - start;
+  if (damage_.first_offset < 0) damage_.first_offset = start;
+  damage_.truncated = offset_ >= file_size_;
+}
+
+const lcm::LogEvent* LogReader::Next() {
+  std::int64_t eventnum, timestamp;
+  std::int32_t clen, dlen;
+  while (offset_ < file_size_) {
+    if (!ReadHeader(&eventnum, &timestamp, &clen, &dlen)) {
+      Resync();
+      continue;
+    }
+    channel_.resize(static_cast<std::size_t>(clen));
+    data_.resize(static_cast<std::size_t>(dlen));
+    if (std::fread(channel_.data(), 1, channel_.size(), file_) != channel_.size() ||
+        std::fread(data_.data(), 1, data_.size(), file_) != data_.size()) {
+      Resync();  // the file shrank while it was read
+      continue;
+    }
+    offset_ += kHeaderBytes + clen + dlen;
+    ++events_read_;
+    event_.eventnum = eventnum;
+    event_.timestamp = timestamp;
+    event_.channel = channel_;
+    event_.datalen = dlen;
+    event_.data = data_.data();
+    return &event_;
+  }
+  return nullptr;
+}
+
+std::string LogReader::DamageSummary() const {
+  if (!damaged()) return "";
+  return "log '" + path_ + "' is damaged: " + std::to_string(damage_.bytes_skipped) +
+         " bytes in " + std::to_string(damage_.regions) + " place(s) skipped, the first at byte " +
+         std::to_string(damage_.first_offset) + (damage_.truncated ? " (cut short at the end)" : "") +
+         "; " + std::to_string(events_read_) + " whole events read";
 }
 
 LogWriter::LogWriter(const std::string& path) : path_(path) {

@@ -98,6 +98,8 @@ int main(int argc, char** argv) {
                 << " tracks outside the image, " << st.frames_without_pose
                 << " frames without pose)\n";
     }
+    for (const std::string& d : data.damaged_logs) std::cerr << "vtrack-eval: " << d << "\n";
+    if (!data.damaged_logs.empty()) return 3;
   } catch (const std::exception& e) {
     std::cerr << "vtrack-eval: " << e.what() << "\n";
     return 1;

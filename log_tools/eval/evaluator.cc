@@ -187,6 +187,13 @@ void AddLog(LogData* data, const std::string& path, const EvalParams& params,
   std::string why;
   lcm_util::LogReader reader(path);
   std::int64_t events = 0;
+  struct DamageNote {  // noted however the loop ends
+    const lcm_util::LogReader& reader;
+    LogData* data;
+    ~DamageNote() {
+      if (reader.damaged()) data->damaged_logs.push_back(reader.DamageSummary());
+    }
+  } note{reader, data};
   while (const lcm::LogEvent* ev = reader.Next()) {
     if (progress && (++events % 256) == 0 && reader.FileSize() > 0) {
       progress(path, static_cast<double>(reader.BytesRead()) / reader.FileSize());

@@ -103,6 +103,7 @@ struct LogData {
   std::optional<Eigen::Isometry3d> body_from_sensor;  // from the first LADAR_SCAN, if any
   std::optional<std::int32_t> sweep_duration_us;       // [us] from the first LADAR_SCAN, if any
   std::map<std::string, std::int64_t> problems;       // counters of skipped input, by reason
+  std::vector<std::string> damaged_logs;              // what was skipped of each damaged log
   std::vector<std::pair<std::int64_t, Eigen::Isometry3d>> pose_samples;  // as read, all logs
 };
 

@@ -99,6 +99,10 @@ int RunLog(const std::string& path, const std::string& channels, int width) {
   if (last_percent >= 0 && tty) std::fputc('\n', stderr);
   const double span = first >= 0 ? (last - first) * 1e-6 : 0.0;
   std::cout << Header(path, span, table) << table.Render(last, /*whole_span=*/true, width);
+  if (reader.damaged()) {
+    std::fprintf(stderr, "vtrack-monitor: %s\n", reader.DamageSummary().c_str());
+    return 3;
+  }
   return 0;
 }
 

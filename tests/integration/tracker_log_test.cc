@@ -278,6 +278,50 @@ TEST_F(TrackerLogTest, LoopedLogResetsTheTrackerWithoutReusingIds) {
   EXPECT_GT(min_id_after, max_id_before);
 }
 
+// A damaged input log (garbage between events, a length near 2^31, a cut end) is read past: the
+// tracker and the monitor say where, use every whole event, write a whole output log and exit 3.
+TEST_F(TrackerLogTest, DamagedLogIsSaidAndReadPast) {
+  const std::string sim = SimLog(*dir_, "paper_fig4_turn", 3.0);
+  std::int64_t whole_scans = 0, whole_events = 0;
+  {
+    lcm_util::LogReader r(sim);
+    while (const lcm::LogEvent* ev = r.Next()) whole_scans += ev->channel == "LADAR_SCAN";
+    whole_events = r.events_read();
+  }
+  std::ifstream in(sim, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t third = bytes.size() / 3;
+  // 128 bytes of garbage a third in and a header claiming 0x7fffffff data bytes two thirds in,
+  // each at an arbitrary offset, inside some event, which is lost.
+  bytes.insert(third, std::string(128, '\x5a'));
+  const std::string huge = std::string("\xed\xa1\xda\x01", 4) + std::string(16, '\0') +
+                           std::string("\x00\x00\x00\x0a\x7f\xff\xff\xff", 8) + "LADAR_SCAN";
+  bytes.insert(2 * bytes.size() / 3, huge);
+  bytes.resize(bytes.size() - 7);  // and the last event cut short
+  const std::string damaged = *dir_ + "/damaged.lcm";
+  std::ofstream(damaged, std::ios::binary) << bytes;
+
+  const std::string out = *dir_ + "/damaged-out.lcm";
+  EXPECT_EQ(Track(damaged, out), 3);
+  const std::string said = ReadFile(out + ".txt");
+  EXPECT_NE(said.find("log '" + damaged + "' is damaged: "), std::string::npos) << said;
+  EXPECT_NE(said.find("(cut short at the end)"), std::string::npos) << said;
+  // One to three events are hit by the damage (two places may fall in one); the rest is read.
+  lcm_util::LogReader reread(damaged);
+  while (reread.Next()) {
+  }
+  EXPECT_GE(reread.events_read(), whole_events - 3);
+  EXPECT_LT(reread.events_read(), whole_events);
+  EXPECT_EQ(reread.damage().regions, 3);
+  EXPECT_GE(LastStatus(out).scans_received, whole_scans - 3);
+  lcm_util::LogReader written(out);
+  while (written.Next()) {
+  }
+  EXPECT_FALSE(written.damaged()) << written.DamageSummary();
+  EXPECT_EQ(RunCommand({Bin("vtrack-monitor"), "--input", damaged}, out + ".monitor.txt"), 3);
+  EXPECT_NE(ReadFile(out + ".monitor.txt").find("is damaged"), std::string::npos);
+}
+
 TEST(TrackerCliTest, HelpAndBadOptions) {
   EXPECT_EQ(RunCommand({Bin("vtrack-tracker"), "--help"}), 0);
   EXPECT_EQ(RunCommand({Bin("vtrack-tracker"), "--no-such-option"}), 2);

@@ -25,6 +25,7 @@
 #include "lcmtypes/util/process.h"
 #include "sensor_driver/kitti/kitti_sequence.h"
 #include "tests/bench/bench_data.h"
+#include "tests/bench/bench_options.h"
 #include "tests/support/subprocess.h"
 #include "vtrack/ladar_scan_t.hpp"
 #include "vtrack/pose_t.hpp"
@@ -73,18 +74,7 @@ int main(int argc, char** argv) {
       "lcm-url", po::value(&url)->default_value("udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608"),
       "LCM URL (udpm)")("tracker-log", po::value(&log)->default_value("/tmp/e2e_latency_tracker.log"),
                         "the tracker's stdout/stderr")("json", po::value(&json), "write the figures here");
-  po::variables_map vm;
-  try {
-    po::store(po::parse_command_line(argc, argv, desc), vm);
-    if (vm.count("help")) {
-      std::cout << desc << "\n";
-      return 0;
-    }
-    po::notify(vm);
-  } catch (const std::exception& e) {
-    std::cerr << "e2e_latency: " << e.what() << "\n" << desc << "\n";
-    return 2;
-  }
+  if (const auto status = vtrack::bench::ParseOptions("e2e_latency", desc, argc, argv)) return *status;
   if (scans <= warmup || scans < 1 || warmup < 0 || !(rate_hz > 0.0 && rate_hz <= 100.0)) {
     std::cerr << "e2e_latency: need scans > warmup >= 0 and rate-hz in (0, 100]; got scans=" << scans
               << " warmup=" << warmup << " rate-hz=" << rate_hz << "\n";

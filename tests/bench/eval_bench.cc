@@ -57,19 +57,25 @@ void BM_GatedAssignment(benchmark::State& state) {
 }
 BENCHMARK(BM_GatedAssignment)->Arg(10)->Arg(50)->Arg(200);
 
-void BM_ClearMot(benchmark::State& state) {
+// score(frames) over 1000 random frames of state.range(0) objects each; items are frames.
+template <class Score>
+void ScoreRandomFrames(benchmark::State& state, Score score) {
   const auto frames = RandomFrames(1000, static_cast<int>(state.range(0)));
-  vtrack::eval::ClearMotParams p;
-  for (auto _ : state) benchmark::DoNotOptimize(vtrack::eval::ComputeClearMot(frames, p));
+  for (auto _ : state) benchmark::DoNotOptimize(score(frames));
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(frames.size()));
+}
+
+void BM_ClearMot(benchmark::State& state) {
+  const vtrack::eval::ClearMotParams p;
+  ScoreRandomFrames(state,
+                    [&](const auto& frames) { return vtrack::eval::ComputeClearMot(frames, p); });
 }
 BENCHMARK(BM_ClearMot)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
 
 void BM_Hota(benchmark::State& state) {
-  const auto frames = RandomFrames(1000, static_cast<int>(state.range(0)));
-  vtrack::eval::HotaParams p;
-  for (auto _ : state) benchmark::DoNotOptimize(vtrack::eval::ComputeHota(frames, p));
-  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(frames.size()));
+  const vtrack::eval::HotaParams p;
+  ScoreRandomFrames(state,
+                    [&](const auto& frames) { return vtrack::eval::ComputeHota(frames, p); });
 }
 BENCHMARK(BM_Hota)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
 

@@ -16,31 +16,26 @@
 namespace vtrack {
 namespace {
 
-using testing::MakeScan;
-using testing::OutlierKind;
-using testing::ScanSpec;
-using testing::SyntheticScan;
-
 // A scan of `truth` from the origin with about `points` returns: the beam step is the box's
 // bearing span divided by the wanted count.
-SyntheticScan ScanWithPoints(const OrientedBox& truth, int points, std::uint32_t seed) {
+testing::SyntheticScan ScanWithPoints(const OrientedBox& truth, int points, std::uint32_t seed) {
   double lo = INFINITY, hi = -INFINITY;
   for (const Eigen::Vector2d& c : truth.Corners()) {
     const double b = std::atan2(c.y(), c.x());
     lo = std::min(lo, b);
     hi = std::max(hi, b);
   }
-  ScanSpec spec;
+  testing::ScanSpec spec;
   spec.truth = truth;
   spec.range_sigma_m = 0.03;
   spec.outlier_fraction = 0.1;
-  spec.outlier_kind = OutlierKind::kSpurious;
+  spec.outlier_kind = testing::OutlierKind::kSpurious;
   spec.angular_step_rad = (hi - lo) / points;
   std::mt19937 rng(seed);
-  return MakeScan(spec, rng);
+  return testing::MakeScan(spec, rng);
 }
 
-FitRequest Request(const SyntheticScan& scan, const OrientedBox& truth, bool track) {
+FitRequest Request(const testing::SyntheticScan& scan, const OrientedBox& truth, bool track) {
   FitRequest req;
   req.x = scan.x;
   req.y = scan.y;
@@ -55,7 +50,7 @@ FitRequest Request(const SyntheticScan& scan, const OrientedBox& truth, bool tra
 }
 
 void Run(benchmark::State& state, const OrientedBox& truth, bool track) {
-  const SyntheticScan scan = ScanWithPoints(truth, static_cast<int>(state.range(0)), 11);
+  const testing::SyntheticScan scan = ScanWithPoints(truth, static_cast<int>(state.range(0)), 11);
   const FitRequest req = Request(scan, truth, track);
   SegmentFitter fitter;
   FitResult fit;

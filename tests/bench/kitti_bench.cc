@@ -38,6 +38,14 @@ const Sequence* RealSequence() {
   return seq.get();
 }
 
+// RealSequence() for a benchmark that needs the real data: when it is absent, the benchmark is
+// skipped, saying so, and nullptr is returned.
+const Sequence* RealSequenceOrSkip(benchmark::State& state) {
+  const Sequence* seq = RealSequence();
+  if (!seq) state.SkipWithError("KITTI data not found (../shared/data/kitti_tracking_0000)");
+  return seq;
+}
+
 // A .bin file of frame 0, real or synthetic.
 std::string FramePath() {
   if (const Sequence* s = RealSequence()) return s->paths().velodyne_dir + "/000000.bin";
@@ -97,11 +105,8 @@ BENCHMARK(BM_EncodeScan)->Unit(benchmark::kMillisecond);
 
 // Real data only: labels are needed.
 void BM_GroundTruthWithPointCounts(benchmark::State& state) {
-  const Sequence* seq = RealSequence();
-  if (!seq) {
-    state.SkipWithError("KITTI data not found (../shared/data/kitti_tracking_0000)");
-    return;
-  }
+  const Sequence* seq = RealSequenceOrSkip(state);
+  if (!seq) return;
   const VelodyneFrame f = seq->ReadFrame(0);
   for (auto _ : state) {
     const auto gt = seq->GroundTruth(0, f);
@@ -112,11 +117,8 @@ BENCHMARK(BM_GroundTruthWithPointCounts)->Unit(benchmark::kMillisecond);
 
 // The whole per-frame conversion as vtrack-kitti2lcm does it (read, scan, truth, encode).
 void BM_ConvertOneFrame(benchmark::State& state) {
-  const Sequence* seq = RealSequence();
-  if (!seq) {
-    state.SkipWithError("KITTI data not found (../shared/data/kitti_tracking_0000)");
-    return;
-  }
+  const Sequence* seq = RealSequenceOrSkip(state);
+  if (!seq) return;
   std::vector<char> buf;
   for (auto _ : state) {
     const VelodyneFrame f = seq->ReadFrame(0);

@@ -80,13 +80,17 @@ const std::vector<Frame>& Frames(std::string* error) {
   return frames;
 }
 
-void BM_Segmentation_Grid(benchmark::State& state) {
+// Frames() for a benchmark: when there are none, the benchmark is skipped, saying why.
+const std::vector<Frame>& FramesOrSkip(benchmark::State& state) {
   std::string error;
   const auto& frames = Frames(&error);
-  if (frames.empty()) {
-    state.SkipWithError(error.c_str());
-    return;
-  }
+  if (frames.empty()) state.SkipWithError(error.c_str());
+  return frames;
+}
+
+void BM_Segmentation_Grid(benchmark::State& state) {
+  const auto& frames = FramesOrSkip(state);
+  if (frames.empty()) return;
   Segmenter seg(GridParams());
   Segments out;
   std::size_t i = 0;
@@ -128,12 +132,8 @@ double AdjustedRand(const std::vector<int>& a, const std::vector<int>& b) {
 }
 
 void BM_Segmentation_PclEuclidean(benchmark::State& state) {
-  std::string error;
-  const auto& frames = Frames(&error);
-  if (frames.empty()) {
-    state.SkipWithError(error.c_str());
-    return;
-  }
+  const auto& frames = FramesOrSkip(state);
+  if (frames.empty()) return;
   const SegmentationParams gp = GridParams();
   std::size_t i = 0;
   double clusters = 0, ari_sum = 0, matched_sum = 0, evaluated = 0;

@@ -88,17 +88,23 @@ void ForEachScan(benchmark::State& state, Body body) {
   }
 }
 
+// ForEachScan whose body returns a count: the counter `name` is its mean per iteration.
+template <class Body>
+void ForEachScanCounting(benchmark::State& state, const char* name, Body body) {
+  double total = 0;
+  ForEachScan(state, [&](const Inputs& in, const StageInput& f) { total += body(in, f); });
+  state.counters[name] = benchmark::Counter(total, benchmark::Counter::kAvgIterations);
+}
+
 void Preprocess(benchmark::State& state, PreprocessParams::Ground ground) {
   PreprocessParams p = bench::ShippedParams().preprocess;
   p.ground = ground;
   Preprocessor pre(p);
   WorldPoints out;
-  double kept = 0;
-  ForEachScan(state, [&](const Inputs& in, const StageInput& f) {
+  ForEachScanCounting(state, "kept", [&](const Inputs& in, const StageInput& f) {
     pre.Run(*f.scan, in.poses, 0, &out);
-    kept += static_cast<double>(out.size());
+    return static_cast<double>(out.size());
   });
-  state.counters["kept"] = benchmark::Counter(kept, benchmark::Counter::kAvgIterations);
 }
 void BM_Compensation(benchmark::State& state) { Preprocess(state, PreprocessParams::Ground::kNone); }
 void BM_CompensationGround(benchmark::State& state) { Preprocess(state, PreprocessParams::Ground::kGrid); }
@@ -108,39 +114,33 @@ BENCHMARK(BM_CompensationGround)->Unit(benchmark::kMillisecond);
 void BM_Segmentation(benchmark::State& state) {
   Segmenter seg(bench::ShippedParams().segmentation);
   Segments out;
-  double n = 0;
-  ForEachScan(state, [&](const Inputs&, const StageInput& f) {
+  ForEachScanCounting(state, "segments", [&](const Inputs&, const StageInput& f) {
     seg.Run(f.points, false, f.sensor_xy, &out);
-    n += static_cast<double>(out.segments.size());
+    return static_cast<double>(out.segments.size());
   });
-  state.counters["segments"] = benchmark::Counter(n, benchmark::Counter::kAvgIterations);
 }
 BENCHMARK(BM_Segmentation)->Unit(benchmark::kMillisecond);
 
 void BM_Association(benchmark::State& state) {
   Associator assoc(bench::ShippedParams().association);
   AssociationResult out;
-  double tracks = 0;
-  ForEachScan(state, [&](const Inputs&, const StageInput& f) {
+  ForEachScanCounting(state, "tracks", [&](const Inputs&, const StageInput& f) {
     assoc.Run(f.predicted, f.points, f.segments, f.sensor_xy, &out);
-    tracks += static_cast<double>(f.predicted.size());
+    return static_cast<double>(f.predicted.size());
   });
-  state.counters["tracks"] = benchmark::Counter(tracks, benchmark::Counter::kAvgIterations);
 }
 BENCHMARK(BM_Association)->Unit(benchmark::kMillisecond);
 
 void BM_HypothesisManagement(benchmark::State& state) {
   std::vector<TrackReport> reports;
-  double tracks = 0;
-  ForEachScan(state, [&](const Inputs&, const StageInput& f) {
+  ForEachScanCounting(state, "tracks", [&](const Inputs&, const StageInput& f) {
     state.PauseTiming();
     TrackManager m(*f.after);
     state.ResumeTiming();
     m.EndScan(f.scan->utime + 100'000);
     m.Report(f.scan->utime + 100'000, &reports);
-    tracks += static_cast<double>(reports.size());
+    return static_cast<double>(reports.size());
   });
-  state.counters["tracks"] = benchmark::Counter(tracks, benchmark::Counter::kAvgIterations);
 }
 BENCHMARK(BM_HypothesisManagement)->Unit(benchmark::kMillisecond);
 

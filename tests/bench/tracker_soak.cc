@@ -18,6 +18,7 @@
 #include <string>
 
 #include "tests/bench/bench_data.h"
+#include "tests/bench/bench_options.h"
 
 namespace po = boost::program_options;
 
@@ -44,18 +45,7 @@ int main(int argc, char** argv) {
       "scenario", po::value(&scenario)->default_value(scenario), "scenario name or file")(
       "minutes", po::value(&minutes)->default_value(minutes), "simulated length [min]")(
       "json", po::value(&json), "write the figures here");
-  po::variables_map vm;
-  try {
-    po::store(po::parse_command_line(argc, argv, desc), vm);
-    if (vm.count("help")) {
-      std::cout << desc << "\n";
-      return 0;
-    }
-    po::notify(vm);
-  } catch (const std::exception& e) {
-    std::cerr << "tracker_soak: " << e.what() << "\n" << desc << "\n";
-    return 2;
-  }
+  if (const auto status = vtrack::bench::ParseOptions("tracker_soak", desc, argc, argv)) return *status;
   if (!(minutes >= 2.0 && minutes <= 120.0)) {
     std::cerr << "tracker_soak: --minutes " << minutes << " must be in [2, 120]\n";
     return 2;

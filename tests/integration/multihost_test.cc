@@ -30,8 +30,8 @@
 #include <vector>
 
 #include "lcmtypes/util/decode.h"
-#include "lcmtypes/util/log_reader.h"
 #include "lcmtypes/util/process.h"
+#include "tests/support/lcm_log.h"
 #include "tests/support/subprocess.h"
 #include "tests/support/test_env.h"
 #include "vtrack/track_list_t.hpp"
@@ -133,25 +133,11 @@ class ThreeHosts {
   std::vector<Host> hosts_;
 };
 
-struct Event {
-  std::int64_t timestamp;  // when lcm-logger received it [us, wall clock]
-  std::string channel, data;
-};
-
-std::vector<Event> ReadLog(const std::string& path) {
-  std::vector<Event> events;
-  lcm_util::LogReader r(path);
-  while (const lcm::LogEvent* ev = r.Next()) {
-    events.push_back({ev->timestamp, ev->channel,
-                      std::string(static_cast<const char*>(ev->data), static_cast<std::size_t>(ev->datalen))});
-  }
-  return events;
-}
-
 // channel -> the messages' bytes, sorted (the sensor host's two processes interleave freely).
-std::map<std::string, std::vector<std::string>> SensorMessages(const std::vector<Event>& events) {
+std::map<std::string, std::vector<std::string>> SensorMessages(
+    const std::vector<LoggedEvent>& events) {
   std::map<std::string, std::vector<std::string>> m;
-  for (const Event& e : events) {
+  for (const LoggedEvent& e : events) {
     if (e.channel == "LADAR_SCAN" || e.channel == "EGO_POSE" || e.channel == "GROUND_TRUTH") {
       m[e.channel].push_back(e.data);
     }
@@ -228,8 +214,8 @@ TEST(MultiHostTest, TracksReachDisplayHostTrackerRestartsWithinOneSecondLoggerLo
                        dir + "/sim.txt"),
             0)
       << ReadFile(dir + "/sim.txt");
-  const std::vector<Event> events = ReadLog(log);
-  const auto published = SensorMessages(ReadLog(sim));
+  const std::vector<LoggedEvent> events = ReadLogEvents(log);
+  const auto published = SensorMessages(ReadLogEvents(sim));
   const auto logged = SensorMessages(events);
   ASSERT_EQ(published.count("LADAR_SCAN"), 1u);
   const std::size_t scans = published.at("LADAR_SCAN").size();
@@ -250,7 +236,7 @@ TEST(MultiHostTest, TracksReachDisplayHostTrackerRestartsWithinOneSecondLoggerLo
   constexpr std::int64_t kInFlightUs = 250'000;
   int before = 0, in_flight = 0, dead = 0, after = 0, confirmed_after = 0;
   std::int64_t first_after = -1, first_confirmed_after = -1;
-  for (const Event& e : events) {
+  for (const LoggedEvent& e : events) {
     if (e.channel != "TRACKS") continue;
     track_list_t t;
     ASSERT_EQ(lcm_util::Decode(e.data.data(), e.data.size(), &t), lcm_util::DecodeError::kNone);
@@ -292,7 +278,7 @@ TEST(MultiHostTest, TracksReachDisplayHostTrackerRestartsWithinOneSecondLoggerLo
   // The restarted tracker's own count: nothing dropped on the compute host.
   tracker_status_t last;
   bool have_status = false;
-  for (const Event& e : events) {
+  for (const LoggedEvent& e : events) {
     if (e.channel == "TRACKER_STATUS" && e.timestamp > restarted_at) {
       have_status = lcm_util::Decode(e.data.data(), e.data.size(), &last) == lcm_util::DecodeError::kNone;
     }

@@ -28,6 +28,20 @@ bool IsVehicle(int8_t c) {
 
 }  // namespace
 
+std::map<std::int64_t, track_list_t> TracksByUtime(const std::string& path) {
+  std::map<std::int64_t, track_list_t> m;
+  lcm_util::LogReader r(path);
+  while (const lcm::LogEvent* ev = r.Next()) {
+    if (ev->channel != "TRACKS") continue;
+    track_list_t t;
+    if (lcm_util::Decode(ev->data, static_cast<std::size_t>(ev->datalen), &t) ==
+        lcm_util::DecodeError::kNone) {
+      m[t.utime] = std::move(t);
+    }
+  }
+  return m;
+}
+
 EvalResult EvaluateTracks(const std::string& truth_log, const std::string& tracks_log,
                           const EvalOptions& opt) {
   std::map<std::int64_t, object_list_t> truth;
@@ -50,18 +64,7 @@ EvalResult EvaluateTracks(const std::string& truth_log, const std::string& track
       }
     }
   }
-  std::map<std::int64_t, track_list_t> tracks;
-  {
-    lcm_util::LogReader r(tracks_log);
-    while (const lcm::LogEvent* ev = r.Next()) {
-      if (ev->channel != "TRACKS") continue;
-      track_list_t m;
-      if (lcm_util::Decode(ev->data, static_cast<std::size_t>(ev->datalen), &m) ==
-          lcm_util::DecodeError::kNone) {
-        tracks[m.utime] = std::move(m);
-      }
-    }
-  }
+  const std::map<std::int64_t, track_list_t> tracks = TracksByUtime(tracks_log);
   EvalResult res;
   std::map<std::int64_t, std::int64_t> first_seen;  // vehicle -> utime of first returns (in view anew)
   std::map<std::int64_t, std::int64_t> last_seen;   // vehicle -> utime of latest returns

@@ -22,6 +22,8 @@
 #include <string>
 #include <vector>
 
+#include "vtrack/track_list_t.hpp"
+
 namespace vtrack::testing {
 
 struct EvalOptions {
@@ -59,6 +61,9 @@ struct EvalResult {
   std::map<std::int64_t, double> vehicle_heading_rmse_deg;  // [deg] axis error per vehicle
   std::map<std::int64_t, std::int64_t> vehicle_due, vehicle_missed;  // due pairs, and those missed
 };
+
+// The TRACKS messages of the log at path, by utime (those that do not decode are left out).
+std::map<std::int64_t, track_list_t> TracksByUtime(const std::string& path);
 
 // truth_log: a log with GROUND_TRUTH and EGO_POSE (vtrack-sim-log). tracks_log: TRACKS.
 // Throws std::runtime_error if a log cannot be read.

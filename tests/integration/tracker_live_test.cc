@@ -33,20 +33,6 @@ const char* kLoggerUrl = "--lcm-url=udpm://239.255.76.67:7667?ttl=0&recv_buf_siz
 
 std::string Bin(const std::string& name) { return BinDir() + "/" + name; }
 
-std::map<std::int64_t, track_list_t> TracksByUtime(const std::string& path) {
-  std::map<std::int64_t, track_list_t> m;
-  lcm_util::LogReader r(path);
-  while (const lcm::LogEvent* ev = r.Next()) {
-    if (ev->channel != "TRACKS") continue;
-    track_list_t t;
-    if (lcm_util::Decode(ev->data, static_cast<std::size_t>(ev->datalen), &t) ==
-        lcm_util::DecodeError::kNone) {
-      m[t.utime] = std::move(t);
-    }
-  }
-  return m;
-}
-
 // Compares two tracker outputs scan by scan: same track ids, states within tolerance [m, rad].
 // Returns the number of scans compared; failures are reported.
 int CompareTracks(const std::map<std::int64_t, track_list_t>& a,

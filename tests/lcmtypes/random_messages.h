@@ -3,6 +3,7 @@
 
 #include <random>
 
+#include "tests/support/encode.h"
 #include "vtrack/ladar_scan_t.hpp"
 #include "vtrack/object_list_t.hpp"
 #include "vtrack/pose_t.hpp"
@@ -146,12 +147,5 @@ class RandomMessages {
  private:
   std::mt19937_64 rng_;
 };
-
-template <class T>
-std::vector<unsigned char> Encode(const T& m) {
-  std::vector<unsigned char> buf(static_cast<size_t>(m.getEncodedSize()));
-  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
-  return buf;
-}
 
 }  // namespace vtrack::testing

@@ -7,29 +7,19 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <optional>
 #include <random>
 #include <set>
 #include <vector>
 
 #include "log_tools/eval/clear_mot.h"
+#include "tests/log_tools/scoring_frames.h"
 
 namespace vtrack::eval {
 namespace {
 
-struct FrameBuilder {
-  ScoringFrame f;
-  explicit FrameBuilder(std::int64_t utime) { f.utime = utime; }
-  FrameBuilder& Gt(std::int64_t id, double x, double y = 0.0) {
-    f.gt_ids.push_back(id);
-    f.gt_xy.emplace_back(x, y);
-    return *this;
-  }
-  FrameBuilder& Tr(std::int64_t id, double x, double y = 0.0) {
-    f.track_ids.push_back(id);
-    f.track_xy.emplace_back(x, y);
-    return *this;
-  }
-};
+using testing::FrameBuilder;
+using testing::Scans;
 
 ClearMotResult Clear(const std::vector<ScoringFrame>& frames, double gate = 2.0) {
   ClearMotParams p;
@@ -37,17 +27,43 @@ ClearMotResult Clear(const std::vector<ScoringFrame>& frames, double gate = 2.0)
   return ComputeClearMot(frames, p);
 }
 
+// The counts of a ClearMotResult a case states (those left empty are not checked).
+struct Counts {
+  std::optional<std::int64_t> gt_detections = {}, true_positives = {}, false_positives = {},
+                              false_negatives = {}, id_switches = {}, fragmentations = {},
+                              gt_objects = {}, mostly_tracked = {}, partially_tracked = {},
+                              mostly_lost = {};
+};
+
+void ExpectCounts(const ClearMotResult& r, const Counts& want) {
+  const auto check = [](const char* name, std::int64_t got, std::optional<std::int64_t> expected) {
+    if (expected) {
+      EXPECT_EQ(got, *expected) << name;
+    }
+  };
+  check("gt_detections", r.gt_detections, want.gt_detections);
+  check("true_positives", r.true_positives, want.true_positives);
+  check("false_positives", r.false_positives, want.false_positives);
+  check("false_negatives", r.false_negatives, want.false_negatives);
+  check("id_switches", r.id_switches, want.id_switches);
+  check("fragmentations", r.fragmentations, want.fragmentations);
+  check("gt_objects", r.gt_objects, want.gt_objects);
+  check("mostly_tracked", r.mostly_tracked, want.mostly_tracked);
+  check("partially_tracked", r.partially_tracked, want.partially_tracked);
+  check("mostly_lost", r.mostly_lost, want.mostly_lost);
+}
+
 TEST(ClearMotTest, PerfectTracking) {
-  std::vector<ScoringFrame> frames;
-  for (int t = 0; t < 10; ++t) frames.push_back(FrameBuilder(t).Gt(1, t).Gt(2, 50, t).Tr(7, t).Tr(8, 50, t).f);
-  const auto r = Clear(frames);
-  EXPECT_EQ(r.gt_detections, 20);
-  EXPECT_EQ(r.true_positives, 20);
-  EXPECT_EQ(r.false_positives, 0);
-  EXPECT_EQ(r.false_negatives, 0);
-  EXPECT_EQ(r.id_switches, 0);
-  EXPECT_EQ(r.fragmentations, 0);
-  EXPECT_EQ(r.mostly_tracked, 2);
+  const auto r = Clear(Scans(10, [](int t) {
+    return FrameBuilder(t).Gt(1, t).Gt(2, 50, t).Tr(7, t).Tr(8, 50, t).f;
+  }));
+  ExpectCounts(r, {.gt_detections = 20,
+                   .true_positives = 20,
+                   .false_positives = 0,
+                   .false_negatives = 0,
+                   .id_switches = 0,
+                   .fragmentations = 0,
+                   .mostly_tracked = 2});
   EXPECT_DOUBLE_EQ(r.mota, 1.0);
   EXPECT_DOUBLE_EQ(r.motp_m, 0.0);
 }
@@ -55,11 +71,9 @@ TEST(ClearMotTest, PerfectTracking) {
 TEST(ClearMotTest, OneIdentitySwitch) {
   // Truth 1 for 10 scans; track 7 covers scans 0-4, track 8 scans 5-9.
   // MOTA = 1 - (0 + 0 + 1) / 10 = 0.9; no gap, so no fragmentation.
-  std::vector<ScoringFrame> frames;
-  for (int t = 0; t < 10; ++t) frames.push_back(FrameBuilder(t).Gt(1, 0).Tr(t < 5 ? 7 : 8, 0.5).f);
-  const auto r = Clear(frames);
-  EXPECT_EQ(r.id_switches, 1);
-  EXPECT_EQ(r.fragmentations, 0);
+  const auto r =
+      Clear(Scans(10, [](int t) { return FrameBuilder(t).Gt(1, 0).Tr(t < 5 ? 7 : 8, 0.5).f; }));
+  ExpectCounts(r, {.id_switches = 1, .fragmentations = 0});
   EXPECT_DOUBLE_EQ(r.mota, 0.9);
   EXPECT_DOUBLE_EQ(r.motp_m, 0.5);
   ASSERT_EQ(r.matches[5].size(), 1u);
@@ -69,37 +83,27 @@ TEST(ClearMotTest, OneIdentitySwitch) {
 
 TEST(ClearMotTest, GapIsAFragmentationAndTwoMisses) {
   // Track 7 misses scans 3 and 4: FN 2, MOTA = 1 - 2/10 = 0.8, one fragmentation, no switch.
-  std::vector<ScoringFrame> frames;
-  for (int t = 0; t < 10; ++t) {
-    FrameBuilder b(t);
-    b.Gt(1, 0);
-    if (t != 3 && t != 4) b.Tr(7, 0);
-    frames.push_back(b.f);
-  }
-  const auto r = Clear(frames);
-  EXPECT_EQ(r.false_negatives, 2);
-  EXPECT_EQ(r.fragmentations, 1);
-  EXPECT_EQ(r.id_switches, 0);
+  const auto r = Clear(testing::TrackMissingScans3And4());
+  // 8/10 scans tracked is not more than 80 %: partially tracked.
+  ExpectCounts(r, {.false_negatives = 2,
+                   .id_switches = 0,
+                   .fragmentations = 1,
+                   .mostly_tracked = 0,
+                   .partially_tracked = 1});
   EXPECT_DOUBLE_EQ(r.mota, 0.8);
-  EXPECT_EQ(r.mostly_tracked, 0);  // 8/10 is not more than 80 %
-  EXPECT_EQ(r.partially_tracked, 1);
 }
 
 TEST(ClearMotTest, SwitchAfterAGapCountsAgainstTheLastMatch) {
   // Scans 0-2 track 7, scan 3 missed, scans 4-5 track 8: the last match (7) persists through the
   // gap, so the return with 8 is a switch; and the gap is a fragmentation.
-  std::vector<ScoringFrame> frames;
-  for (int t = 0; t < 6; ++t) {
+  const auto r = Clear(Scans(6, [](int t) {
     FrameBuilder b(t);
     b.Gt(1, 0);
     if (t < 3) b.Tr(7, 0);
     if (t > 3) b.Tr(8, 0);
-    frames.push_back(b.f);
-  }
-  const auto r = Clear(frames);
-  EXPECT_EQ(r.id_switches, 1);
-  EXPECT_EQ(r.fragmentations, 1);
-  EXPECT_EQ(r.false_negatives, 1);
+    return b.f;
+  }));
+  ExpectCounts(r, {.false_negatives = 1, .id_switches = 1, .fragmentations = 1});
   EXPECT_NEAR(r.mota, 1.0 - 2.0 / 6.0, 1e-12);
 }
 
@@ -121,48 +125,35 @@ TEST(ClearMotTest, PreviousCorrespondenceIsKeptOverACheaperSwap) {
 }
 
 TEST(ClearMotTest, OutsideTheGateIsAMissAndAFalsePositive) {
-  std::vector<ScoringFrame> frames;
-  for (int t = 0; t < 4; ++t) frames.push_back(FrameBuilder(t).Gt(1, 0).Tr(7, 2.5).f);
-  const auto r = Clear(frames);
-  EXPECT_EQ(r.false_negatives, 4);
-  EXPECT_EQ(r.false_positives, 4);
+  const auto r = Clear(Scans(4, [](int t) { return FrameBuilder(t).Gt(1, 0).Tr(7, 2.5).f; }));
+  ExpectCounts(r, {.false_positives = 4, .false_negatives = 4, .mostly_lost = 1});
   EXPECT_DOUBLE_EQ(r.mota, -1.0);
   EXPECT_TRUE(std::isnan(r.motp_m));
-  EXPECT_EQ(r.mostly_lost, 1);
 }
 
 TEST(ClearMotTest, MostlyTrackedAndLostThresholds) {
   // Four truth objects over 10 scans, matched in 9, 8, 2 and 1 scans: MT (> 80 %), PT, PT, ML.
-  std::vector<ScoringFrame> frames;
   const int matched[4] = {9, 8, 2, 1};
-  for (int t = 0; t < 10; ++t) {
+  const auto r = Clear(Scans(10, [&](int t) {
     FrameBuilder b(t);
     for (int k = 0; k < 4; ++k) {
       b.Gt(k, 100.0 * k);
       if (t < matched[k]) b.Tr(10 + k, 100.0 * k);
     }
-    frames.push_back(b.f);
-  }
-  const auto r = Clear(frames);
-  EXPECT_EQ(r.gt_objects, 4);
-  EXPECT_EQ(r.mostly_tracked, 1);
-  EXPECT_EQ(r.partially_tracked, 2);
-  EXPECT_EQ(r.mostly_lost, 1);
+    return b.f;
+  }));
+  ExpectCounts(r, {.gt_objects = 4, .mostly_tracked = 1, .partially_tracked = 2, .mostly_lost = 1});
 }
 
 TEST(ClearMotTest, AbsenceFromTheScoredSetIsNotAMiss) {
   // Truth 1 leaves the scored set in scans 3-4 (e.g. outside the labelled region): neither a miss
   // nor a fragmentation.
-  std::vector<ScoringFrame> frames;
-  for (int t = 0; t < 8; ++t) {
+  const auto r = Clear(Scans(8, [](int t) {
     FrameBuilder b(t);
     if (t != 3 && t != 4) b.Gt(1, 0).Tr(7, 0);
-    frames.push_back(b.f);
-  }
-  const auto r = Clear(frames);
-  EXPECT_EQ(r.gt_detections, 6);
-  EXPECT_EQ(r.false_negatives, 0);
-  EXPECT_EQ(r.fragmentations, 0);
+    return b.f;
+  }));
+  ExpectCounts(r, {.gt_detections = 6, .false_negatives = 0, .fragmentations = 0});
   EXPECT_DOUBLE_EQ(r.mota, 1.0);
 }
 
@@ -324,15 +315,15 @@ TEST(ClearMotTest, LargeRandomCaseAgreesWithSecondImplementation) {
   ASSERT_GT(ref.frag, 20);
   ASSERT_GT(ref.fp, 200);
   ASSERT_GT(ref.gt, 5000);
-  EXPECT_EQ(r.gt_detections, ref.gt);
-  EXPECT_EQ(r.true_positives, ref.tp);
-  EXPECT_EQ(r.false_positives, ref.fp);
-  EXPECT_EQ(r.false_negatives, ref.fn);
-  EXPECT_EQ(r.id_switches, ref.idsw);
-  EXPECT_EQ(r.fragmentations, ref.frag);
-  EXPECT_EQ(r.mostly_tracked, ref.mt);
-  EXPECT_EQ(r.partially_tracked, ref.pt);
-  EXPECT_EQ(r.mostly_lost, ref.ml);
+  ExpectCounts(r, {.gt_detections = ref.gt,
+                   .true_positives = ref.tp,
+                   .false_positives = ref.fp,
+                   .false_negatives = ref.fn,
+                   .id_switches = ref.idsw,
+                   .fragmentations = ref.frag,
+                   .mostly_tracked = ref.mt,
+                   .partially_tracked = ref.pt,
+                   .mostly_lost = ref.ml});
   EXPECT_NEAR(r.mota, 1.0 - static_cast<double>(ref.fn + ref.fp + ref.idsw) / ref.gt, 1e-12);
   EXPECT_NEAR(r.motp_m, ref.dist / ref.tp, 1e-9);
 }

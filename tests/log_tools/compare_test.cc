@@ -13,18 +13,17 @@
 #include "tests/log_tools/synthetic_run.h"
 #include "tests/support/subprocess.h"
 #include "tests/support/test_env.h"
+#include "tests/support/tool_test.h"
 
 namespace vtrack::testing {
 namespace {
 
 namespace fs = std::filesystem;
 
-class CompareTest : public ::testing::Test {
+class CompareTest : public ToolTest {
  protected:
-  void SetUp() override {
-    exe_ = BinDir() + "/vtrack-compare";
-    if (!fs::exists(exe_)) GTEST_SKIP() << exe_ << " is not built";
-    dir_ = ScratchDir("compare");
+  CompareTest() : ToolTest("vtrack-compare", "compare") {}
+  void Prepare() override {
     // The stand-in tools: links named like the real ones to the fake (built beside this test).
     const fs::path fake = fs::read_symlink("/proc/self/exe").parent_path() / "fake_vtrack_tool";
     ASSERT_TRUE(fs::exists(fake)) << fake;
@@ -34,16 +33,7 @@ class CompareTest : public ::testing::Test {
       fs::create_symlink(fake, fs::path(fake_bin_) / name);
     }
   }
-  int RunTool(std::vector<std::string> args, std::string* output, std::vector<std::string> env = {}) {
-    args.insert(args.begin(), exe_);
-    const std::string log = dir_ + "/out.txt";
-    Subprocess p(args, log, env);
-    auto rc = p.Wait(std::chrono::seconds(120));
-    const int status = rc ? *rc : p.Stop();
-    *output = ReadFile(log);
-    return status;
-  }
-  std::string exe_, dir_, fake_bin_;
+  std::string fake_bin_;
 };
 
 TEST_F(CompareTest, HelpAndBadOptions) {

@@ -6,7 +6,6 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <cmath>
-#include <filesystem>
 #include <fstream>
 #include <numbers>
 #include <sstream>
@@ -15,31 +14,21 @@
 #include "tests/log_tools/synthetic_run.h"
 #include "tests/support/subprocess.h"
 #include "tests/support/test_env.h"
+#include "tests/support/tool_test.h"
 
 namespace vtrack::testing {
 namespace {
 
-namespace fs = std::filesystem;
-
-class EvalCliTest : public ::testing::Test {
+class EvalCliTest : public ToolTest {
  protected:
-  void SetUp() override {
-    exe_ = BinDir() + "/vtrack-eval";
-    if (!fs::exists(exe_)) GTEST_SKIP() << exe_ << " is not built";
-    dir_ = ScratchDir("eval_cli");
+  EvalCliTest() : ToolTest("vtrack-eval", "eval_cli") {}
+  void Prepare() override {
     run_ = dir_ + "/run.lcm";
     tracks_ = dir_ + "/tracks.lcm";
     WriteSyntheticRun(run_);
     WriteSyntheticTracks(tracks_, "vasm");
   }
-  int RunTool(std::vector<std::string> args, std::string* output) {
-    args.insert(args.begin(), exe_);
-    const std::string log = dir_ + "/out.txt";
-    const int rc = RunCommand(args, log);
-    *output = ReadFile(log);
-    return rc;
-  }
-  std::string exe_, dir_, run_, tracks_;
+  std::string run_, tracks_;
 };
 
 TEST_F(EvalCliTest, HelpAndBadOptions) {

@@ -44,12 +44,30 @@ vtrack::testing::SyntheticSequence WriteSynthetic(const std::string& dir) {
   return s;
 }
 
+// Writes the synthetic sequence into a fresh scratch directory; returns the options that read it.
+SequenceOptions WriteSyntheticOptions(const std::string& scratch_name) {
+  SequenceOptions so;
+  so.dir = ScratchDir(scratch_name);
+  WriteSynthetic(so.dir);
+  so.poses_file = so.dir + "/poses.txt";
+  so.sink = [](const std::string&) {};
+  return so;
+}
+
 struct Event {
   std::int64_t timestamp;
   std::string channel;
   std::int64_t utime;
   std::int64_t seq = -1;  // scan seq / truth scan_seq
 };
+
+// Decodes one event as a Msg with the checked decoder (a failure is reported, not fatal).
+template <typename Msg>
+Msg DecodeEvent(const lcm::LogEvent& ev) {
+  Msg m;
+  EXPECT_EQ(Decode(ev.data, static_cast<std::size_t>(ev.datalen), &m), DecodeError::kNone);
+  return m;
+}
 
 // Reads every event, decodes it with the checked decoder, and returns them in file order.
 std::vector<Event> ReadLog(const std::string& path) {
@@ -58,22 +76,17 @@ std::vector<Event> ReadLog(const std::string& path) {
   while (const lcm::LogEvent* ev = reader.Next()) {
     Event e{ev->timestamp, ev->channel, 0};
     if (e.channel == "LADAR_SCAN") {
-      vtrack::ladar_scan_t m;
-      EXPECT_EQ(Decode(ev->data, static_cast<std::size_t>(ev->datalen), &m), DecodeError::kNone);
+      const auto m = DecodeEvent<vtrack::ladar_scan_t>(*ev);
       e.utime = m.utime;
       e.seq = m.seq;
     } else if (e.channel == "EGO_POSE") {
-      vtrack::pose_t m;
-      EXPECT_EQ(Decode(ev->data, static_cast<std::size_t>(ev->datalen), &m), DecodeError::kNone);
-      e.utime = m.utime;
+      e.utime = DecodeEvent<vtrack::pose_t>(*ev).utime;
     } else if (e.channel == "GROUND_TRUTH") {
-      vtrack::object_list_t m;
-      EXPECT_EQ(Decode(ev->data, static_cast<std::size_t>(ev->datalen), &m), DecodeError::kNone);
+      const auto m = DecodeEvent<vtrack::object_list_t>(*ev);
       e.utime = m.utime;
       e.seq = m.scan_seq;
     } else if (e.channel == "DETECTIONS") {
-      vtrack::detection_list_t m;
-      EXPECT_EQ(Decode(ev->data, static_cast<std::size_t>(ev->datalen), &m), DecodeError::kNone);
+      const auto m = DecodeEvent<vtrack::detection_list_t>(*ev);
       e.utime = m.utime;
       e.seq = m.seq;
     } else {
@@ -85,15 +98,10 @@ std::vector<Event> ReadLog(const std::string& path) {
 }
 
 TEST(KittiConvertTest, SyntheticLogHasEveryChannelInTimeOrder) {
-  const std::string dir = ScratchDir("kitti_convert");
-  WriteSynthetic(dir);
-  SequenceOptions so;
-  so.dir = dir;
-  so.poses_file = dir + "/poses.txt";
-  so.sink = [](const std::string&) {};
+  const SequenceOptions so = WriteSyntheticOptions("kitti_convert");
   const Sequence seq(so);
   ConvertOptions co;
-  co.out = dir + "/out.lcm";
+  co.out = so.dir + "/out.lcm";
   int progress_calls = 0;
   const auto stats = ConvertSequence(seq, co, [&](int done, int total, std::int64_t) {
     ++progress_calls;
@@ -137,15 +145,10 @@ TEST(KittiConvertTest, SyntheticLogHasEveryChannelInTimeOrder) {
 
 // At a rate whose period does not divide the frame period, every frame still has its own pose.
 TEST(KittiConvertTest, EveryFrameHasItsPoseAtAnyRate) {
-  const std::string dir = ScratchDir("kitti_convert_rate");
-  WriteSynthetic(dir);
-  SequenceOptions so;
-  so.dir = dir;
-  so.poses_file = dir + "/poses.txt";
-  so.sink = [](const std::string&) {};
+  const SequenceOptions so = WriteSyntheticOptions("kitti_convert_rate");
   const Sequence seq(so);
   ConvertOptions co;
-  co.out = dir + "/out.lcm";
+  co.out = so.dir + "/out.lcm";
   co.pose_period_us = 30'000;
   co.first_frame = 1;
   co.num_frames = 3;

@@ -17,6 +17,7 @@
 #include "log_tools/eval/kitti_mot.h"
 #include "tests/support/subprocess.h"
 #include "tests/support/test_env.h"
+#include "tests/support/tool_test.h"
 
 namespace vtrack::testing {
 namespace {
@@ -263,12 +264,38 @@ HandCase MakeHandCase() {
   return c;
 }
 
+// A case of the given label rows and result rows (with their scores).
+HandCase FromRows(const std::vector<Row>& labels, const std::vector<Row>& results) {
+  HandCase c;
+  for (const Row& r : labels) c.labels += Line(r, false);
+  for (const Row& r : results) c.results += Line(r, true);
+  return c;
+}
+
 PreparedSequence Prepare(const HandCase& c, const std::string& name, const Params& params) {
   const std::string dir = ScratchDir("kitti_mot_" + name);
   WriteFile(dir + "/labels/0000.txt", c.labels);
   WriteFile(dir + "/results/0000.txt", c.results);
   return PreparedSequence(name, ReadTrackingFile(dir + "/labels/0000.txt", false),
                           ReadTrackingFile(dir + "/results/0000.txt", true), params);
+}
+
+// The figures every counting case below states.
+struct KeyCounts {
+  int ids = 0, frag = 0, tp = 0;
+  double mota = 0.0;
+};
+
+// Counts the case without a score threshold and checks its key counts; returns all the counts.
+Counts CountAndCheck(const HandCase& c, const std::string& name, const Params& params,
+                     const KeyCounts& want) {
+  SCOPED_TRACE(name);
+  const Counts n = Prepare(c, name, params).Evaluate(kNoThreshold);
+  EXPECT_EQ(n.ids, want.ids);
+  EXPECT_EQ(n.frag, want.frag);
+  EXPECT_EQ(n.tp, want.tp);
+  EXPECT_NEAR(n.Mota(), want.mota, kEps);
+  return n;
 }
 
 TEST(KittiMotCounting, HandBuiltSequence) {
@@ -302,13 +329,10 @@ TEST(KittiMotCounting, StricterIouThreshold) {
   // TP 4, FN 2, FP 3, IDS 0, FRAG 1 (car 2); MOTA = 1 - (2 + 3 + 0) / 6 = 1/6.
   Params p;
   p.min_iou = 0.7;
-  const Counts c = Prepare(MakeHandCase(), "hand07", p).Evaluate(kNoThreshold);
-  EXPECT_EQ(c.tp, 4);
+  const Counts c =
+      CountAndCheck(MakeHandCase(), "hand07", p, {.ids = 0, .frag = 1, .tp = 4, .mota = 1.0 / 6.0});
   EXPECT_EQ(c.fn, 2);
   EXPECT_EQ(c.fp, 3);
-  EXPECT_EQ(c.ids, 0);
-  EXPECT_EQ(c.frag, 1);
-  EXPECT_NEAR(c.Mota(), 1.0 / 6.0, kEps);
 }
 
 TEST(KittiMotCounting, ReacquiredUnderAnotherIdIsAFragmentationNotASwitch) {
@@ -316,17 +340,11 @@ TEST(KittiMotCounting, ReacquiredUnderAnotherIdIsAFragmentationNotASwitch) {
   // counts a switch only between consecutive matched appearances, so none here; a
   // fragmentation where track 2 resumes it (frame 2: -1 -> 2, matched before, next matched).
   // TP 3, FN 1: MOTA = 1 - 1/4.
-  HandCase c;
-  for (int f = 0; f < 4; ++f) c.labels += Line({f, 7, "Car"}, false);
-  c.results += Line({0, 1, "Car"}, true);
-  c.results += Line({2, 2, "Car"}, true);
-  c.results += Line({3, 2, "Car"}, true);
-  const Counts n = Prepare(c, "reacquire", Params{}).Evaluate(kNoThreshold);
-  EXPECT_EQ(n.ids, 0);
-  EXPECT_EQ(n.frag, 1);
-  EXPECT_EQ(n.tp, 3);
+  const HandCase c = FromRows({{0, 7, "Car"}, {1, 7, "Car"}, {2, 7, "Car"}, {3, 7, "Car"}},
+                              {{0, 1, "Car"}, {2, 2, "Car"}, {3, 2, "Car"}});
+  const Counts n =
+      CountAndCheck(c, "reacquire", Params{}, {.ids = 0, .frag = 1, .tp = 3, .mota = 0.75});
   EXPECT_EQ(n.fn, 1);
-  EXPECT_NEAR(n.Mota(), 0.75, kEps);
 }
 
 TEST(KittiMotCounting, AnIgnoredAppearanceBreaksTheIdentityChain) {
@@ -334,20 +352,12 @@ TEST(KittiMotCounting, AnIgnoredAppearanceBreaksTheIdentityChain) {
   // frame 1 ignored: the ignored appearance resets the last id, so frame 1 -> 2 is no switch and
   // no fragmentation (without the reset it would be one of each). Frame 1's match is an ignored
   // TP: TP 2, ignored TP 1, FN 0, FP 0, MOTA 1.
-  HandCase c;
-  c.labels += Line({0, 7, "Car"}, false);
-  c.labels += Line({1, 7, "Car", 0, 3}, false);
-  c.labels += Line({2, 7, "Car"}, false);
-  c.results += Line({0, 1, "Car"}, true);
-  c.results += Line({1, 2, "Car"}, true);
-  c.results += Line({2, 2, "Car"}, true);
-  const Counts n = Prepare(c, "ignored_middle", Params{}).Evaluate(kNoThreshold);
-  EXPECT_EQ(n.ids, 0);
-  EXPECT_EQ(n.frag, 0);
-  EXPECT_EQ(n.tp, 2);
+  const HandCase c = FromRows({{0, 7, "Car"}, {1, 7, "Car", 0, 3}, {2, 7, "Car"}},
+                              {{0, 1, "Car"}, {1, 2, "Car"}, {2, 2, "Car"}});
+  const Counts n =
+      CountAndCheck(c, "ignored_middle", Params{}, {.ids = 0, .frag = 0, .tp = 2, .mota = 1.0});
   EXPECT_EQ(n.ignored_tp, 1);
   EXPECT_EQ(n.fp, 0);
-  EXPECT_NEAR(n.Mota(), 1.0, kEps);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -437,30 +447,21 @@ TEST(KittiMotSweep, HandWorkedSamota) {
 // ---------------------------------------------------------------------------------------------
 // vtrack-eval-kitti as a process
 
-class KittiMotCliTest : public ::testing::Test {
+class KittiMotCliTest : public ToolTest {
  protected:
-  void SetUp() override {
-    exe_ = BinDir() + "/vtrack-eval-kitti";
-    if (!fs::exists(exe_)) GTEST_SKIP() << exe_ << " is not built";
-    dir_ = ScratchDir("kitti_mot_cli");
+  KittiMotCliTest() : ToolTest("vtrack-eval-kitti", "kitti_mot_cli") {}
+  void Prepare() override {
     const HandCase c = MakeHandCase();
     WriteFile(dir_ + "/labels/0000.txt", c.labels);
     WriteFile(dir_ + "/results/0000.txt", c.results);
   }
-  int Run(std::vector<std::string> args, std::string* out) {
-    args.insert(args.begin(), exe_);
-    const int rc = RunCommand(args, dir_ + "/out.txt");
-    *out = ReadFile(dir_ + "/out.txt");
-    return rc;
-  }
-  std::string exe_, dir_;
 };
 
 TEST_F(KittiMotCliTest, HandCaseThroughTheCommand) {
   std::string out;
-  ASSERT_EQ(Run({"--labels", dir_ + "/labels", "--results", dir_ + "/results", "--sequences",
-                 "0", "--json", dir_ + "/m.json"},
-                &out),
+  ASSERT_EQ(RunTool({"--labels", dir_ + "/labels", "--results", dir_ + "/results", "--sequences",
+                     "0", "--json", dir_ + "/m.json"},
+                    &out),
             0)
       << out;
   EXPECT_NE(out.find("[1/1] 0000"), std::string::npos) << out;  // progress line
@@ -475,41 +476,42 @@ TEST_F(KittiMotCliTest, HandCaseThroughTheCommand) {
     EXPECT_EQ(s["fn"].as<int>(), 1);
   }
   EXPECT_NEAR(j["params"]["min_iou"].as<double>(), 0.25, 1e-12);
-  ASSERT_EQ(Run({"--labels", dir_ + "/labels", "--results", dir_ + "/results", "--iou", "0.7",
-                 "-q", "--json", dir_ + "/m7.json"},
-                &out),
+  ASSERT_EQ(RunTool({"--labels", dir_ + "/labels", "--results", dir_ + "/results", "--iou", "0.7",
+                     "-q", "--json", dir_ + "/m7.json"},
+                    &out),
             0)
       << out;
   EXPECT_EQ(out.find("[1/1]"), std::string::npos) << out;  // -q
   EXPECT_NEAR(YAML::LoadFile(dir_ + "/m7.json")["all"]["mota"].as<double>(), 1.0 / 6.0, 1e-6);
   // Without --sequences: every NNNN.txt in --labels, nothing else.
   WriteFile(dir_ + "/labels/notes.txt", "not a sequence\n");
-  EXPECT_EQ(Run({"--labels", dir_ + "/labels", "--results", dir_ + "/results"}, &out), 0) << out;
+  EXPECT_EQ(RunTool({"--labels", dir_ + "/labels", "--results", dir_ + "/results"}, &out), 0)
+      << out;
   EXPECT_NE(out.find("[1/1] 0000"), std::string::npos) << out;
 }
 
 TEST_F(KittiMotCliTest, HelpAndErrors) {
   std::string out;
-  EXPECT_EQ(Run({"--help"}, &out), 0);
+  EXPECT_EQ(RunTool({"--help"}, &out), 0);
   EXPECT_NE(out.find("--sequences"), std::string::npos) << out;
-  EXPECT_EQ(Run({"--results", dir_ + "/results"}, &out), 2);
+  EXPECT_EQ(RunTool({"--results", dir_ + "/results"}, &out), 2);
   EXPECT_NE(out.find("--labels DIR is required"), std::string::npos) << out;
-  EXPECT_EQ(Run({"--labels", dir_ + "/labels", "--results", dir_ + "/results", "--iou", "0"},
-                &out),
+  EXPECT_EQ(RunTool({"--labels", dir_ + "/labels", "--results", dir_ + "/results", "--iou", "0"},
+                    &out),
             2);
   EXPECT_NE(out.find("--iou must be in (0, 1]"), std::string::npos) << out;
-  EXPECT_EQ(Run({"--labels", dir_ + "/nowhere", "--results", dir_ + "/results"}, &out), 2);
+  EXPECT_EQ(RunTool({"--labels", dir_ + "/nowhere", "--results", dir_ + "/results"}, &out), 2);
   EXPECT_NE(out.find("nowhere: not a directory"), std::string::npos) << out;
   // A sequence without a result file.
   WriteFile(dir_ + "/labels/0002.txt", MakeHandCase().labels);
-  EXPECT_EQ(Run({"--labels", dir_ + "/labels", "--results", dir_ + "/results", "--sequences",
-                 "0000,0002"},
-                &out),
+  EXPECT_EQ(RunTool({"--labels", dir_ + "/labels", "--results", dir_ + "/results", "--sequences",
+                     "0000,0002"},
+                    &out),
             1);
   EXPECT_NE(out.find("results/0002.txt: cannot open"), std::string::npos) << out;
   // A malformed line names the file and the line.
   WriteFile(dir_ + "/bad/0000.txt", MakeHandCase().results + "3 1 Car 0 0 -1 1 2 3\n");
-  EXPECT_EQ(Run({"--labels", dir_ + "/labels", "--results", dir_ + "/bad"}, &out), 1);
+  EXPECT_EQ(RunTool({"--labels", dir_ + "/labels", "--results", dir_ + "/bad"}, &out), 1);
   EXPECT_NE(out.find("bad/0000.txt:11: 9 fields"), std::string::npos) << out;
 }
 

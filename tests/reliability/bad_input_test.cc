@@ -21,6 +21,7 @@
 
 #include "lcmtypes/util/decode.h"
 #include "sensor_driver/driver/sim_cli.h"
+#include "tests/support/encode.h"
 #include "tracker/core/parameters.h"
 #include "tracker/tracker_node.h"
 #include "vtrack/ladar_scan_t.hpp"
@@ -30,12 +31,7 @@
 namespace vtrack {
 namespace {
 
-template <class T>
-std::vector<std::uint8_t> Encode(const T& m) {
-  std::vector<std::uint8_t> b(static_cast<std::size_t>(m.getEncodedSize()));
-  m.encode(b.data(), 0, static_cast<int>(b.size()));
-  return b;
-}
+using testing::Encode;
 
 // What the node published: the tracks of every TRACKS message, encoded (latency left out).
 struct Output {

@@ -27,6 +27,7 @@
 
 #include "lcmtypes/util/decode.h"
 #include "sensor_driver/driver/sim_cli.h"
+#include "tests/support/encode.h"
 #include "tracker/config.h"
 #include "tracker/tracker_node.h"
 #include "vtrack/ladar_scan_t.hpp"
@@ -65,12 +66,7 @@ double Quantile(std::vector<double> v, double q) {
   return v[k];
 }
 
-template <class T>
-std::vector<std::uint8_t> Encode(const T& m) {
-  std::vector<std::uint8_t> b(static_cast<std::size_t>(m.getEncodedSize()));
-  m.encode(b.data(), 0, static_cast<int>(b.size()));
-  return b;
-}
+using testing::Encode;
 
 struct Window {
   std::vector<double> scan_cpu_ms;  // tracker CPU per processed scan

@@ -3,18 +3,15 @@
 // reader's (sensor_driver/kitti) moved to the run's start time. Skips without the real data.
 #include <gtest/gtest.h>
 
-#include <signal.h>
-
 #include <chrono>
 #include <cmath>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "lcmtypes/util/log_reader.h"
 #include "lcmtypes/util/process.h"
 #include "sensor_driver/kitti/kitti_sequence.h"
-#include "tests/support/subprocess.h"
+#include "tests/support/lcm_log.h"
 #include "tests/support/test_env.h"
 
 namespace vtrack {
@@ -23,11 +20,9 @@ namespace {
 using namespace std::chrono_literals;
 using testing::BinDir;
 using testing::KittiDir;
-using testing::ReadFile;
+using testing::kTestBusUrl;
 using testing::ScratchDir;
-using testing::Subprocess;
 
-constexpr char kUrl[] = "udpm://239.255.76.67:7667?ttl=0";
 constexpr char kLoggerUrl[] = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216";
 
 template <class T>
@@ -57,24 +52,11 @@ TEST(KittiReplayTest, DriverAndEgoPosePublishTheSequenceOnTheRunClock) {
   const std::vector<std::string> common{"--kitti", KittiDir(), "--cache-dir", cache,
                                         "--start-utime", std::to_string(start), "--laps", "1",
                                         "--stop-after", std::to_string(3.0 + 3.5 / rate),
-                                        "--rate", std::to_string(rate), "--lcm-url", kUrl, "-q"};
+                                        "--rate", std::to_string(rate), "--lcm-url", kTestBusUrl,
+                                        "-q"};
   const std::string log = dir + "/live.lcm";
-  {
-    Subprocess logger({"lcm-logger", "-q", "-f", std::string("--lcm-url=") + kLoggerUrl, log},
-                      dir + "/logger.txt");
-    std::vector<std::string> d{BinDir() + "/vtrack-ladar-driver"}, e{BinDir() + "/vtrack-ego-pose"};
-    d.insert(d.end(), common.begin(), common.end());
-    e.insert(e.end(), common.begin(), common.end());
-    Subprocess driver(d, dir + "/driver.txt");
-    Subprocess ego(e, dir + "/ego.txt");
-    const auto ds = driver.Wait(60000ms), es = ego.Wait(60000ms);
-    ASSERT_TRUE(ds && es);
-    EXPECT_EQ(*ds, 0) << ReadFile(dir + "/driver.txt");
-    EXPECT_EQ(*es, 0) << ReadFile(dir + "/ego.txt");
-    std::this_thread::sleep_for(700ms);
-    logger.Signal(SIGINT);
-    ASSERT_TRUE(logger.Wait(5000ms).has_value());
-  }
+  testing::RecordDriverAndEgoPose(dir, common, kLoggerUrl, log, 60000ms, 700ms);
+  ASSERT_FALSE(HasFatalFailure());
   const std::int64_t shift = start - seq.ScanUtime(0);
   int scans = 0, truths = 0, poses = 0;
   lcm_util::LogReader r(log);

@@ -6,6 +6,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "sensor_driver/sim/ladar.h"
@@ -136,19 +137,23 @@ TEST(LadarTest, BoxReturnsOnlyOnVisibleFacesWithinNoise) {
   int n_visible = 0;
   for (int f = 0; f < 4; ++f) n_visible += visible(f);
   ASSERT_EQ(n_visible, 2);  // a corner view
-
-  // Expected rays per face, noise-free, from the ray-segment intersections.
-  const LadarParams clean = Planar(0.25, 0.0);
-  std::array<int, 4> expected{0, 0, 0, 0};
-  for (int j = 0; j < clean.NumColumns(); ++j) {
-    const double az = DegToRad(-90.0 + j * 0.25);
-    const Vector2d u(std::cos(az), std::sin(az));
+  // The face a ray from the sensor along u hits first, and the range there (-1 and kInf if none).
+  auto first_hit = [&](const Vector2d& u) {
     double best = kInf;
     int face = -1;
     for (int f = 0; f < 4; ++f) {
       const double r = RaySegment(sensor, u, corners[faces[f].first], corners[faces[f].second]);
       if (r < best) best = r, face = f;
     }
+    return std::make_pair(face, best);
+  };
+
+  // Expected rays per face, noise-free, from the ray-segment intersections.
+  const LadarParams clean = Planar(0.25, 0.0);
+  std::array<int, 4> expected{0, 0, 0, 0};
+  for (int j = 0; j < clean.NumColumns(); ++j) {
+    const double az = DegToRad(-90.0 + j * 0.25);
+    const int face = first_hit(Vector2d(std::cos(az), std::sin(az))).first;
     if (face >= 0) ++expected[face];
   }
   const Sweep s0 = Cast(clean, scene, 1);
@@ -183,13 +188,7 @@ TEST(LadarTest, BoxReturnsOnlyOnVisibleFacesWithinNoise) {
     for (int i = 0; i < s.scan.npoints; ++i) {
       const Vector2d p(s.scan.x[i], s.scan.y[i]);
       const double az = std::atan2(p.y(), p.x());
-      const Vector2d u(std::cos(az), std::sin(az));
-      double best = kInf;
-      int face = -1;
-      for (int f = 0; f < 4; ++f) {
-        const double r = RaySegment(sensor, u, corners[faces[f].first], corners[faces[f].second]);
-        if (r < best) best = r, face = f;
-      }
+      const auto [face, best] = first_hit(Vector2d(std::cos(az), std::sin(az)));
       ASSERT_GE(face, 0) << "a return where no face is";
       EXPECT_TRUE(visible(face));
       const double res = p.norm() - best;

@@ -5,8 +5,6 @@
 // time through the wall clock.
 #include <gtest/gtest.h>
 
-#include <signal.h>
-
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -15,10 +13,10 @@
 #include <vector>
 
 #include "lcmtypes/util/decode.h"
-#include "lcmtypes/util/log_reader.h"
 #include "lcmtypes/util/process.h"
 #include "sensor_driver/sim/scenario.h"
 #include "sensor_driver/sim/simulator.h"
+#include "tests/support/lcm_log.h"
 #include "tests/support/subprocess.h"
 #include "tests/support/test_env.h"
 #include "vtrack/ladar_scan_t.hpp"
@@ -30,29 +28,17 @@ namespace {
 
 using namespace std::chrono_literals;
 using testing::BinDir;
+using testing::kTestBusUrl;
+using testing::LoggedEvent;
 using testing::ReadFile;
+using testing::ReadLogEvents;
+using testing::RecordDriverAndEgoPose;
 using testing::RunCommand;
 using testing::ScratchDir;
+using testing::StopLogger;
 using testing::Subprocess;
 
-constexpr char kUrl[] = "udpm://239.255.76.67:7667?ttl=0";
 constexpr char kLoggerUrl[] = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608";
-
-struct Event {
-  std::int64_t timestamp;
-  std::string channel;
-  std::string data;
-};
-
-std::vector<Event> ReadLog(const std::string& path) {
-  std::vector<Event> out;
-  lcm_util::LogReader r(path);
-  while (const lcm::LogEvent* e = r.Next()) {
-    out.push_back({e->timestamp, e->channel,
-                   std::string(static_cast<const char*>(e->data), static_cast<std::size_t>(e->datalen))});
-  }
-  return out;
-}
 
 template <class T>
 T DecodeOrDie(const std::string& data) {
@@ -61,36 +47,10 @@ T DecodeOrDie(const std::string& data) {
   return m;
 }
 
-std::map<std::string, std::vector<std::string>> ByChannel(const std::vector<Event>& events) {
+std::map<std::string, std::vector<std::string>> ByChannel(const std::vector<LoggedEvent>& events) {
   std::map<std::string, std::vector<std::string>> out;
-  for (const Event& e : events) out[e.channel].push_back(e.data);
+  for (const LoggedEvent& e : events) out[e.channel].push_back(e.data);
   return out;
-}
-
-// Stops lcm-logger the way a user does (Ctrl-C), so that it flushes.
-void StopLogger(Subprocess* logger) {
-  std::this_thread::sleep_for(500ms);  // the last datagrams written
-  logger->Signal(SIGINT);
-  const auto st = logger->Wait(5000ms);
-  ASSERT_TRUE(st.has_value()) << "lcm-logger did not stop on SIGINT";
-}
-
-// The driver and the ego-pose process with the same options (`common`), recorded by lcm-logger
-// into `log` until both end (within 30 s).
-void RecordDriverAndEgoPose(const std::string& dir, const std::vector<std::string>& common,
-                            const std::string& log) {
-  Subprocess logger({"lcm-logger", "-q", "-f", std::string("--lcm-url=") + kLoggerUrl, log},
-                    dir + "/logger.txt");
-  std::vector<std::string> d{BinDir() + "/vtrack-ladar-driver"}, e{BinDir() + "/vtrack-ego-pose"};
-  d.insert(d.end(), common.begin(), common.end());
-  e.insert(e.end(), common.begin(), common.end());
-  Subprocess driver(d, dir + "/driver.txt");
-  Subprocess ego(e, dir + "/ego.txt");
-  const auto d_st = driver.Wait(30000ms), e_st = ego.Wait(30000ms);
-  ASSERT_TRUE(d_st.has_value() && e_st.has_value()) << "the run did not end on time";
-  EXPECT_EQ(*d_st, 0) << ReadFile(dir + "/driver.txt");
-  EXPECT_EQ(*e_st, 0) << ReadFile(dir + "/ego.txt");
-  StopLogger(&logger);
 }
 
 TEST(SimLiveTest, TenSecondsOfDriverEgoPoseAndLogger) {
@@ -100,16 +60,17 @@ TEST(SimLiveTest, TenSecondsOfDriverEgoPoseAndLogger) {
   const std::string scenario = "paper_fig4_turn";
   // One run of 10 s starting on a whole millisecond 2.5 s from now (the processes wait for it).
   const std::int64_t start = (lcm_util::WallUtime() / 1000 + 2500) * 1000;
-  const std::vector<std::string> common{"--scenario", scenario, "--duration", "10", "--start-utime",
-                                        std::to_string(start), "--laps", "1", "--lcm-url", kUrl};
-  RecordDriverAndEgoPose(dir, common, log);
+  const std::vector<std::string> common{"--scenario", scenario, "--duration", "10",
+                                        "--start-utime", std::to_string(start), "--laps", "1",
+                                        "--lcm-url", kTestBusUrl};
+  RecordDriverAndEgoPose(dir, common, kLoggerUrl, log, 30000ms, 500ms);
   ASSERT_FALSE(HasFatalFailure());
-  const auto events = ReadLog(log);
+  const auto events = ReadLogEvents(log);
   sim::Simulator sim(sim::LoadScenario(sim::ResolveScenarioPath(scenario), 10.0));
   std::vector<ladar_scan_t> scans;
   std::vector<object_list_t> truths;
   std::vector<pose_t> poses;
-  for (const Event& ev : events) {
+  for (const LoggedEvent& ev : events) {
     if (ev.channel == "LADAR_SCAN") {
       scans.push_back(DecodeOrDie<ladar_scan_t>(ev.data));
       // Received when the sweep was complete, within scheduling and network jitter.
@@ -143,7 +104,7 @@ TEST(SimLiveTest, TenSecondsOfDriverEgoPoseAndLogger) {
                         "--start-utime", std::to_string(start), "--out", ref, "-q"},
                        dir + "/sim_log.txt"),
             0);
-  const auto live = ByChannel(events), offline = ByChannel(ReadLog(ref));
+  const auto live = ByChannel(events), offline = ByChannel(ReadLogEvents(ref));
   for (const char* ch : {"LADAR_SCAN", "GROUND_TRUTH", "EGO_POSE"}) {
     ASSERT_EQ(live.at(ch).size(), offline.at(ch).size()) << ch;
     for (std::size_t i = 0; i < live.at(ch).size(); ++i) {
@@ -164,16 +125,16 @@ TEST(SimLiveTest, SlowMotionKeepsTheDataAndHalvesThePace) {
   const std::int64_t start = (lcm_util::WallUtime() / 1000 + 2500) * 1000;
   const std::vector<std::string> common{"--scenario", scenario, "--duration", "3", "--start-utime",
                                         std::to_string(start), "--laps", "1", "--rate", "0.5",
-                                        "--lcm-url", kUrl, "-q"};
-  RecordDriverAndEgoPose(dir, common, log);
+                                        "--lcm-url", kTestBusUrl, "-q"};
+  RecordDriverAndEgoPose(dir, common, kLoggerUrl, log, 30000ms, 500ms);
   ASSERT_FALSE(HasFatalFailure());
   const std::string ref = dir + "/ref.lcm";
   ASSERT_EQ(RunCommand({BinDir() + "/vtrack-sim-log", "--scenario", scenario, "--duration", "3",
                         "--start-utime", std::to_string(start), "--out", ref, "-q"},
                        dir + "/sim_log.txt"),
             0);
-  const auto events = ReadLog(log);
-  const auto live = ByChannel(events), offline = ByChannel(ReadLog(ref));
+  const auto events = ReadLogEvents(log);
+  const auto live = ByChannel(events), offline = ByChannel(ReadLogEvents(ref));
   for (const char* ch : {"LADAR_SCAN", "GROUND_TRUTH", "EGO_POSE"}) {
     ASSERT_TRUE(live.count(ch)) << ch << " missing";
     ASSERT_EQ(live.at(ch).size(), offline.at(ch).size()) << ch;
@@ -183,7 +144,7 @@ TEST(SimLiveTest, SlowMotionKeepsTheDataAndHalvesThePace) {
   }
   // The pace: arrival (logger's wall clock) against the stamp, stretched by 1 / rate from U.
   int checked = 0;
-  for (const Event& ev : events) {
+  for (const LoggedEvent& ev : events) {
     std::int64_t due = 0;
     if (ev.channel == "LADAR_SCAN") {
       const auto scan = DecodeOrDie<ladar_scan_t>(ev.data);
@@ -232,17 +193,17 @@ TEST(SimLiveTest, SeparatelyStartedProcessesAgreeOnTheWallClock) {
                       dir + "/logger.txt");
     std::this_thread::sleep_for(300ms);
     Subprocess ego({BinDir() + "/vtrack-ego-pose", "--scenario", scenario, "--stop-after", "5",
-                    "--lcm-url", kUrl},
+                    "--lcm-url", kTestBusUrl},
                    dir + "/ego.txt");
     std::this_thread::sleep_for(1300ms);
     Subprocess driver({BinDir() + "/vtrack-ladar-driver", "--scenario", scenario, "--stop-after",
-                       "3", "--lcm-url", kUrl},
+                       "3", "--lcm-url", kTestBusUrl},
                       dir + "/driver.txt");
     const auto d_st = driver.Wait(15000ms), e_st = ego.Wait(15000ms);
     ASSERT_TRUE(d_st.has_value() && e_st.has_value());
     EXPECT_EQ(*d_st, 0) << ReadFile(dir + "/driver.txt");
     EXPECT_EQ(*e_st, 0) << ReadFile(dir + "/ego.txt");
-    StopLogger(&logger);
+    StopLogger(&logger, 500ms);
   }
   const std::int64_t lap = 16'000'000;  // the scenario's duration: laps start at multiples of it
   std::map<std::int64_t, std::map<std::string, std::map<std::int64_t, std::string>>> ref;  // lap -> channel -> utime -> bytes
@@ -252,7 +213,7 @@ TEST(SimLiveTest, SeparatelyStartedProcessesAgreeOnTheWallClock) {
       EXPECT_EQ(RunCommand({BinDir() + "/vtrack-sim-log", "--scenario", scenario, "--start-utime",
                             std::to_string(lap_start), "--out", path, "-q"}),
                 0);
-      for (const Event& e : ReadLog(path)) {
+      for (const LoggedEvent& e : ReadLogEvents(path)) {
         std::int64_t utime;
         if (e.channel == "EGO_POSE") utime = DecodeOrDie<pose_t>(e.data).utime;
         else if (e.channel == "LADAR_SCAN") utime = DecodeOrDie<ladar_scan_t>(e.data).utime;
@@ -263,7 +224,7 @@ TEST(SimLiveTest, SeparatelyStartedProcessesAgreeOnTheWallClock) {
     return ref[lap_start];
   };
   int scans = 0, poses = 0;
-  for (const Event& e : ReadLog(log)) {
+  for (const LoggedEvent& e : ReadLogEvents(log)) {
     if (e.channel == "EGO_POSE") {
       const pose_t p = DecodeOrDie<pose_t>(e.data);
       auto& r = reference(p.utime / lap * lap)["EGO_POSE"];

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "lcmtypes/util/decode.h"
-#include "lcmtypes/util/log_reader.h"
+#include "tests/support/lcm_log.h"
 #include "tests/support/subprocess.h"
 #include "tests/support/test_env.h"
 #include "base/angle.h"
@@ -23,7 +23,9 @@ namespace vtrack {
 namespace {
 
 using testing::BinDir;
+using testing::LoggedEvent;
 using testing::ReadFile;
+using testing::ReadLogEvents;
 using testing::RunCommand;
 using testing::ScratchDir;
 
@@ -33,24 +35,8 @@ int SimLog(const std::vector<std::string>& args, const std::string& log) {
   return RunCommand(argv, log);
 }
 
-struct Event {
-  std::int64_t timestamp;
-  std::string channel;
-  std::string data;
-};
-
-std::vector<Event> ReadLog(const std::string& path) {
-  std::vector<Event> out;
-  lcm_util::LogReader r(path);
-  while (const lcm::LogEvent* e = r.Next()) {
-    out.push_back({e->timestamp, e->channel,
-                   std::string(static_cast<const char*>(e->data), static_cast<std::size_t>(e->datalen))});
-  }
-  return out;
-}
-
 template <class T>
-T DecodeOrDie(const Event& e) {
+T DecodeOrDie(const LoggedEvent& e) {
   T m;
   std::string why;
   const auto err = lcm_util::Decode(e.data.data(), e.data.size(), &m, &why);
@@ -91,12 +77,12 @@ TEST(SimLogTest, EveryChannelAtItsRateWithoutGaps) {
             0)
       << ReadFile(dir + "/out.txt");
   EXPECT_NE(ReadFile(dir + "/out.txt").find("real time"), std::string::npos);
-  const auto events = ReadLog(log);
+  const auto events = ReadLogEvents(log);
   std::vector<ladar_scan_t> scans;
   std::vector<object_list_t> truths;
   std::vector<pose_t> poses;
   std::int64_t last_ts = 0;
-  for (const Event& e : events) {
+  for (const LoggedEvent& e : events) {
     EXPECT_GE(e.timestamp, last_ts);
     last_ts = e.timestamp;
     if (e.channel == "LADAR_SCAN") {
@@ -154,7 +140,7 @@ TEST(SimLogTest, GroundTruthAgreesWithTheReturns) {
   PoseHistory history(100'000'000);
   std::vector<ladar_scan_t> scans;
   std::vector<object_list_t> truths;
-  for (const Event& e : ReadLog(log)) {
+  for (const LoggedEvent& e : ReadLogEvents(log)) {
     if (e.channel == "EGO_POSE") {
       const pose_t p = DecodeOrDie<pose_t>(e);
       history.Add(p.utime, PoseOf(p));

@@ -102,6 +102,14 @@ struct KnownScene {
     z_center = center + 3.2 * Eigen::Vector2d(-std::sin(theta), std::cos(theta));
   }
 
+  // The covariance of (x, y, theta) with the given position block and theta variance.
+  static Eigen::Matrix3d PoseCovariance(const Eigen::Matrix2d& position, double theta_variance) {
+    Eigen::Matrix3d c = Eigen::Matrix3d::Zero();
+    c.topLeftCorner<2, 2>() = position;
+    c(2, 2) = theta_variance;
+    return c;
+  }
+
   Scene Make() const {
     Scene s;
     s.utime = 1'700'000'000'000'000;
@@ -110,12 +118,8 @@ struct KnownScene {
     t.model = MotionModel::kVasm;
     t.moving = true;
     t.object_class = TrackClass::kVehicle;
-    t.box.center = center;
-    t.box.theta = theta;
-    t.box.length = length;
-    t.box.width = width;
-    t.cov.topLeftCorner<2, 2>() = cov;
-    t.cov(2, 2) = 0.01;
+    t.box = {center, theta, length, width};
+    t.cov = PoseCovariance(cov, 0.01);
     t.rear_axle_offset = rear_axle;
     t.speed = 6.0;
     t.num_hypotheses = 2;
@@ -123,12 +127,8 @@ struct KnownScene {
     SceneMeasurement m;
     m.track_id = 7;
     m.fit_kind = FitKind::kCorner;
-    m.z_box.center = z_center;
-    m.z_box.theta = z_theta;
-    m.z_box.length = length;
-    m.z_box.width = width;
-    m.R.topLeftCorner<2, 2>() = r;
-    m.R(2, 2) = 0.004;
+    m.z_box = {z_center, z_theta, length, width};
+    m.R = PoseCovariance(r, 0.004);
     m.edges = {edge1, edge2};
     s.measurements.push_back(m);
     return s;

@@ -12,6 +12,7 @@
 #include <set>
 
 #include "base/angle.h"
+#include "tests/support/params_check.h"
 #include "tracker/core/segmentation.h"
 
 namespace vtrack {
@@ -349,19 +350,15 @@ TEST(AssociatorTest, SideOfALongMoverSeenEdgeOnJoinsIt) {
 
 TEST(AssociatorTest, ValidateNamesTheKey) {
   AssociationParams p;
-  std::string error;
-  EXPECT_TRUE(p.Validate(&error));
+  EXPECT_TRUE(testing::Accepted(p));
   p.min_inside_fraction = 0.0;
-  EXPECT_FALSE(p.Validate(&error));
-  EXPECT_NE(error.find("min_inside_fraction = 0"), std::string::npos);
+  EXPECT_TRUE(testing::RefusedSaying(p, {"min_inside_fraction = 0"}));
   p = AssociationParams{};
   p.mover_column_deg = 90.0;
-  EXPECT_FALSE(p.Validate(&error));
-  EXPECT_NE(error.find("association.mover_column_deg = 90"), std::string::npos) << error;
+  EXPECT_TRUE(testing::RefusedSaying(p, {"association.mover_column_deg = 90"}));
   GrazingJoinParams g;
   g.max_gap = -1.0;
-  EXPECT_FALSE(g.Validate(&error));
-  EXPECT_NE(error.find("grazing.max_gap = -1"), std::string::npos) << error;
+  EXPECT_TRUE(testing::RefusedSaying(g, {"grazing.max_gap = -1"}));
 }
 
 }  // namespace

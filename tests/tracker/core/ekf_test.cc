@@ -30,6 +30,15 @@ Eigen::Matrix3d RandomR(std::mt19937_64& rng, double scale) {
   return scale * (A * A.transpose() / 3.0 + 0.2 * Eigen::Matrix3d::Identity());
 }
 
+// A hypothesis of `kind` with state (x0, ..., x5) and the default covariance.
+Hypothesis MakeHypothesis(ModelKind kind, double x0, double x1, double x2, double x3, double x4,
+                          double x5) {
+  Hypothesis h;
+  h.kind = kind;
+  h.x << x0, x1, x2, x3, x4, x5;
+  return h;
+}
+
 // Samples N(mean, cov) for the Monte Carlo checks.
 template <int N>
 Eigen::Matrix<double, N, 1> Sample(const Eigen::Matrix<double, N, 1>& mean,
@@ -100,9 +109,7 @@ TEST(Ekf, NisIsChiSquareAndGateRefusesItsShare) {
   const double gate_probability = 0.95;
   const Ekf ekf(IsmParams(), VasmParams(), EkfParams{gate_probability});
   std::mt19937_64 rng(5);
-  Hypothesis prior;
-  prior.kind = ModelKind::kVasm;
-  prior.x << 10.0, -4.0, -1.3, 7.0, 2.0, 0.2;
+  Hypothesis prior = MakeHypothesis(ModelKind::kVasm, 10.0, -4.0, -1.3, 7.0, 2.0, 0.2);
   prior.P = RandomSpd(rng, 0.04);
   const Eigen::Matrix3d R = RandomR(rng, 0.01);
   const int n = 20000;
@@ -163,9 +170,7 @@ TEST(Ekf, OrientationInnovationIsWrapped) {
 
 TEST(Ekf, GatedMeasurementLeavesHypothesisUnchanged) {
   const Ekf ekf;
-  Hypothesis h;
-  h.kind = ModelKind::kIsm;
-  h.x << 0.0, 1.0, 0.0, 0.0, 0.0, 0.0;
+  Hypothesis h = MakeHypothesis(ModelKind::kIsm, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0);
   h.P = Matrix6d::Identity() * 0.01;
   const Hypothesis before = h;
   CentreMeasurement m;
@@ -183,9 +188,7 @@ TEST(Ekf, GatedMeasurementLeavesHypothesisUnchanged) {
 
 TEST(Ekf, BadMeasurementOrStateIsRefusedWithReason) {
   const Ekf ekf;
-  Hypothesis good;
-  good.kind = ModelKind::kVasm;
-  good.x << 0.0, 0.0, -1.0, 5.0, 0.0, 0.0;
+  Hypothesis good = MakeHypothesis(ModelKind::kVasm, 0.0, 0.0, -1.0, 5.0, 0.0, 0.0);
   CentreMeasurement ok;
   ok.R = Eigen::Matrix3d::Identity() * 0.01;
 
@@ -236,8 +239,7 @@ TEST(Ekf, CallerErrorsThrowNamingTheValue) {
 TEST(Ekf, PredictScalesSystemNoise) {
   const Ekf ekf;
   const double dt = 0.2, k = 2.5;
-  Hypothesis h;
-  h.x << 1.0, 2.0, 3.0, 4.0, 0.5, 0.1;
+  Hypothesis h = MakeHypothesis(ModelKind::kIsm, 1.0, 2.0, 3.0, 4.0, 0.5, 0.1);
   h.P.setZero();
   ekf.Predict(dt, k, &h);
   const double alpha = ekf.ism().params().alpha, beta = ekf.ism().params().beta;
@@ -276,8 +278,7 @@ TEST(Ekf, CovarianceStaysSymmetricPositiveDefinite) {
 
 TEST(Ekf, CentreEstimateOfBothModels) {
   const Ekf ekf;
-  Hypothesis ism;
-  ism.x << 1.0, -3.0, 2.0, 4.0, 0.3, 0.2;
+  Hypothesis ism = MakeHypothesis(ModelKind::kIsm, 1.0, -3.0, 2.0, 4.0, 0.3, 0.2);
   ism.P = Matrix6d::Identity() * 0.5;
   ism.P(1, 3) = ism.P(3, 1) = 0.1;
   const CentreEstimate a = ekf.Centre(ism);
@@ -290,9 +291,7 @@ TEST(Ekf, CentreEstimateOfBothModels) {
 
   // VASM: centre velocity of a rigid body, v_axis + theta_dot z x (centre - axis), with the axis
   // point at L along the heading; its covariance from Monte Carlo of that formula.
-  Hypothesis vasm;
-  vasm.kind = ModelKind::kVasm;
-  vasm.x << 1.0, 2.0, -1.3, 6.0, -2.8, 0.4;
+  Hypothesis vasm = MakeHypothesis(ModelKind::kVasm, 1.0, 2.0, -1.3, 6.0, -2.8, 0.4);
   std::mt19937_64 rng(21);
   vasm.P = RandomSpd(rng, 1e-4);
   auto rigid_velocity = [](const Vector6d& x) {
@@ -328,8 +327,7 @@ TEST(Ekf, CentreEstimateOfBothModels) {
 TEST(Ekf, ConvertIsmToVasmAndBack) {
   const Ekf ekf;
   std::mt19937_64 rng(33);
-  Hypothesis ism;
-  ism.x << 4.0, 3.0, -2.0, 5.0, 0.9, 0.25;
+  Hypothesis ism = MakeHypothesis(ModelKind::kIsm, 4.0, 3.0, -2.0, 5.0, 0.9, 0.25);
   ism.P = RandomSpd(rng, 1e-3);
 
   // ISM -> VASM: v is the centre velocity along the heading; L from the prior.
@@ -385,9 +383,7 @@ TEST(Ekf, ConvertIsmToVasmAndBack) {
 // While a corner leaves the orientation ambiguous, a second VASM is held at theta + 90 deg.
 TEST(Ekf, ConvertVasmToAlternativeOrientation) {
   const Ekf ekf;
-  Hypothesis vasm;
-  vasm.kind = ModelKind::kVasm;
-  vasm.x << 2.0, 1.0, -1.2, 0.4, kPi - 0.3, 0.05;
+  Hypothesis vasm = MakeHypothesis(ModelKind::kVasm, 2.0, 1.0, -1.2, 0.4, kPi - 0.3, 0.05);
   std::mt19937_64 rng(41);
   vasm.P = RandomSpd(rng, 1e-2);
   const Hypothesis turned = ekf.Convert(vasm, ModelKind::kVasm, kPi / 2.0);
@@ -406,8 +402,7 @@ TEST(Ekf, ConvertVasmToAlternativeOrientation) {
   EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0);
 
   // ISM turned by 90 deg keeps its velocity.
-  Hypothesis ism;
-  ism.x << 0.0, 1.0, 0.0, 2.0, 0.1, 0.0;
+  Hypothesis ism = MakeHypothesis(ModelKind::kIsm, 0.0, 1.0, 0.0, 2.0, 0.1, 0.0);
   const Hypothesis ism_turned = ekf.Convert(ism, ModelKind::kIsm, kPi / 2.0);
   EXPECT_NEAR(ism_turned.x(4), 0.1 + kPi / 2.0, 1e-12);
   EXPECT_EQ(ism_turned.x(1), 1.0);
@@ -419,8 +414,7 @@ TEST(Ekf, ConvertVasmToAlternativeOrientation) {
 // the one-step result).
 TEST(Ekf, PredictedTrajectoryOfIsmMatchesClosedForm) {
   const Ekf ekf;
-  Hypothesis h;
-  h.x << 1.0, 2.0, -1.0, -0.5, 0.2, 0.1;
+  Hypothesis h = MakeHypothesis(ModelKind::kIsm, 1.0, 2.0, -1.0, -0.5, 0.2, 0.1);
   h.P = Matrix6d::Zero();
   h.P.diagonal() << 0.04, 0.25, 0.04, 0.25, 0.01, 0.0025;
   const Hypothesis before = h;

@@ -44,6 +44,13 @@ FitRequest RequestFor(const SyntheticScan& scan, const ScanSpec& spec, std::uint
   return r;
 }
 
+// RequestFor with the true heading predicted (a confirmed track's case).
+FitRequest TrackRequestFor(const SyntheticScan& scan, const ScanSpec& spec, std::uint64_t seed) {
+  FitRequest r = RequestFor(scan, spec, seed);
+  r.predicted_theta = spec.truth.theta;
+  return r;
+}
+
 // Normalised estimation error squared of z against the true centre pose.
 double Nees(const FitResult& fit, const OrientedBox& truth) {
   const Eigen::Vector3d e(fit.z.x() - truth.center.x(), fit.z.y() - truth.center.y(),
@@ -423,8 +430,7 @@ void ExpectMonteCarloMatchesR(const OrientedBox& nominal, const Eigen::Vector2d&
     truth.width += size_jitter(rng);
     spec.truth = truth;
     const SyntheticScan scan = MakeScan(spec, rng);
-    FitRequest req = RequestFor(scan, spec, t);
-    req.predicted_theta = truth.theta;
+    FitRequest req = TrackRequestFor(scan, spec, t);
     fitter.Fit(req, &fit);
     ASSERT_EQ(fit.kind, expected_kind) << ToString(fit.failure);
     errors.emplace_back(fit.z.x() - truth.center.x(), fit.z.y() - truth.center.y(),
@@ -477,8 +483,7 @@ TEST(Fitting, GaussNewtonReachesTheEq16Minimum) {
     const OrientedBox truth = RandomVehicle(rng, 2, DegToRad(20.0));
     ScanSpec spec = RandomSpec(rng, truth, OutlierKind::kClutter);
     const SyntheticScan scan = MakeScan(spec, rng);
-    FitRequest req = RequestFor(scan, spec, t);
-    req.predicted_theta = truth.theta;
+    FitRequest req = TrackRequestFor(scan, spec, t);
     const FitResult fit = fitter.Fit(req);
     if (fit.kind != FitKind::kCorner) continue;
     ++checked;
@@ -654,8 +659,7 @@ TEST(Fitting, ExtentsAndFullViewFlags) {
   int full = 0;
   for (int t = 0; t < 100; ++t) {
     const SyntheticScan scan = MakeScan(spec, rng);
-    FitRequest req = RequestFor(scan, spec, t);
-    req.predicted_theta = truth.theta;
+    FitRequest req = TrackRequestFor(scan, spec, t);
     const FitResult fit = fitter.Fit(req);
     ASSERT_EQ(fit.kind, FitKind::kCorner);
     len_err.push_back(fit.observed_length_m - truth.length);
@@ -677,8 +681,7 @@ TEST(Fitting, ExtentsAndFullViewFlags) {
   for (bool ccw : {true, false}) {
     spec.occlude_ccw = ccw;
     const SyntheticScan scan = MakeScan(spec, rng);
-    FitRequest req = RequestFor(scan, spec, 7);
-    req.predicted_theta = truth.theta;
+    FitRequest req = TrackRequestFor(scan, spec, 7);
     const FitResult fit = fitter.Fit(req);
     ASSERT_NE(fit.kind, FitKind::kNone);
     const bool short_length = fit.observed_length_m < truth.length - 0.5;
@@ -713,8 +716,7 @@ TEST(Fitting, InsideFractionRejectsWithReason) {
   }
   const double car_share = static_cast<double>(car.size()) / scan.size();  // 0.75
   SegmentFitter fitter;
-  FitRequest req = RequestFor(scan, spec, 5);
-  req.predicted_theta = truth.theta;
+  FitRequest req = TrackRequestFor(scan, spec, 5);
   req.min_inside_fraction = car_share - 0.1;
   FitResult fit = fitter.Fit(req);
   ASSERT_NE(fit.kind, FitKind::kNone) << ToString(fit.failure);
@@ -738,8 +740,7 @@ TEST(Fitting, PointFlagsMarkTheFacesHit) {
   spec.range_sigma_m = 0.03;
   spec.outlier_fraction = 0.2;
   const SyntheticScan scan = MakeScan(spec, rng);
-  FitRequest req = RequestFor(scan, spec, 1);
-  req.predicted_theta = truth.theta;
+  FitRequest req = TrackRequestFor(scan, spec, 1);
   SegmentFitter fitter;
   const FitResult fit = fitter.Fit(req);
   ASSERT_EQ(fit.kind, FitKind::kCorner);
@@ -889,8 +890,7 @@ TEST(Fitting, DeterministicForASeedAndReusesTheResult) {
   spec.outlier_fraction = 0.3;
   spec.outlier_kind = OutlierKind::kClutter;
   const SyntheticScan scan = MakeScan(spec, rng);
-  FitRequest req = RequestFor(scan, spec, 99);
-  req.predicted_theta = truth.theta;
+  FitRequest req = TrackRequestFor(scan, spec, 99);
   SegmentFitter a, b;
   FitResult ra, rb;
   a.Fit(req, &ra);
@@ -918,8 +918,7 @@ TEST(Fitting, FarFromTheWorldOrigin) {
   spec.truth = truth;
   spec.sensor = offset;
   const SyntheticScan scan = MakeScan(spec, rng);
-  FitRequest req = RequestFor(scan, spec, 3);
-  req.predicted_theta = truth.theta;
+  FitRequest req = TrackRequestFor(scan, spec, 3);
   SegmentFitter fitter;
   const FitResult fit = fitter.Fit(req);
   ASSERT_NE(fit.kind, FitKind::kNone);

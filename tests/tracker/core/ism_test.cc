@@ -7,12 +7,16 @@
 #include <random>
 #include <stdexcept>
 
+#include "tests/support/grid.h"
+#include "tests/support/params_check.h"
 #include "tests/tracker/core/jacobian_check.h"
 #include "base/angle.h"
 
 namespace vtrack {
 namespace {
 
+using testing::ForEachCombination;
+using testing::With;
 using testing::JacobianCheckOptions;
 using testing::JacobianMatchesCentralDifferences;
 
@@ -24,23 +28,18 @@ TEST(Ism, PhiMatchesCentralDifferences) {
   const IsmModel model;
   JacobianCheckOptions options;
   options.angle_outputs = {4};
-  int checked = 0;
-  for (double dt : kDts) {
-    for (double theta : {0.4, kPi - 1e-9, -kPi + 1e-9, kPi}) {
-      for (double theta_dot : {0.0, 1e-9, -1e-9, 0.7, -2.0}) {
-        for (double speed : {0.0, 8.0, -3.0}) {
-          Vector6d x;
-          x << 12.0, speed * std::cos(1.1), -7.0, speed * std::sin(1.1), theta, theta_dot;
-          Matrix6d Phi;
-          model.Propagate(x, dt, &Phi);
-          auto f = [&](const Vector6d& xi) { return model.Propagate(xi, dt); };
-          EXPECT_TRUE(JacobianMatchesCentralDifferences(f, x, Phi, options))
-              << "dt " << dt << " theta " << theta << " theta_dot " << theta_dot;
-          ++checked;
-        }
-      }
-    }
-  }
+  const int checked = ForEachCombination(
+      {std::begin(kDts), std::end(kDts)}, {0.4, kPi - 1e-9, -kPi + 1e-9, kPi},
+      {0.0, 1e-9, -1e-9, 0.7, -2.0}, {0.0, 8.0, -3.0},
+      [&](double dt, double theta, double theta_dot, double speed) {
+        Vector6d x;
+        x << 12.0, speed * std::cos(1.1), -7.0, speed * std::sin(1.1), theta, theta_dot;
+        Matrix6d Phi;
+        model.Propagate(x, dt, &Phi);
+        auto f = [&](const Vector6d& xi) { return model.Propagate(xi, dt); };
+        EXPECT_TRUE(JacobianMatchesCentralDifferences(f, x, Phi, options))
+            << "dt " << dt << " theta " << theta << " theta_dot " << theta_dot;
+      });
   EXPECT_EQ(checked, 5 * 4 * 5 * 3);
 }
 
@@ -138,19 +137,11 @@ TEST(Ism, InitFromMeasurementTakesPoseAndCovarianceFromIt) {
 }
 
 TEST(Ism, ParamsValidationNamesFieldAndValue) {
-  std::string error;
-  EXPECT_TRUE(IsmParams().Validate(&error)) << error;
-  IsmParams p;
-  p.beta = -0.5;
-  EXPECT_FALSE(p.Validate(&error));
-  EXPECT_NE(error.find("beta"), std::string::npos) << error;
-  EXPECT_NE(error.find("-0.5"), std::string::npos) << error;
-  p = IsmParams();
-  p.alpha = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_FALSE(p.Validate(&error));
-  EXPECT_NE(error.find("alpha"), std::string::npos) << error;
-  p = IsmParams();
-  p.initial_velocity_std = 0.0;
+  EXPECT_TRUE(testing::Accepted(IsmParams()));
+  EXPECT_TRUE(testing::RefusedSaying(With(&IsmParams::beta, -0.5), {"beta", "-0.5"}));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_TRUE(testing::RefusedSaying(With(&IsmParams::alpha, nan), {"alpha"}));
+  const IsmParams p = With(&IsmParams::initial_velocity_std, 0.0);
   EXPECT_FALSE(p.Validate(nullptr));
   try {
     IsmModel model(p);

@@ -80,38 +80,69 @@ constexpr int kRuns = 100;
 constexpr int kSteps = 60;  // 6 s at 10 Hz
 constexpr double kDt = 0.1;
 
+// The measured (x, y, theta) in a state of the model `kind`.
+Eigen::Vector3d MeasuredPose(ModelKind kind, const Vector6d& x) {
+  return kind == ModelKind::kVasm ? Eigen::Vector3d(x(0), x(1), x(4))
+                                  : Eigen::Vector3d(x(0), x(2), x(4));
+}
+
+// Runs `ekf` kRuns times over kSteps scans of a simulated truth and adds each step's NEES to
+// (*nees_sum)[step]. Each run, `start()` puts the truth at its first state (in the layout of
+// `kind`) and returns it; the hypothesis starts there plus a draw from P0. Each scan, `step()`
+// moves the truth by kDt and returns its state, measured with noise MeasurementR(2 deg).
+template <typename Start, typename Step>
+void AddNees(const Ekf& ekf, ModelKind kind, const Matrix6d& P0, Start start, Step step,
+             std::mt19937_64& rng, std::vector<double>* nees_sum) {
+  const Eigen::Matrix3d R = MeasurementR(2.0);
+  nees_sum->assign(kSteps, 0.0);
+  for (int run = 0; run < kRuns; ++run) {
+    Hypothesis h;
+    h.kind = kind;
+    h.x = start() + Sample<6>(P0, rng);
+    h.x(4) = WrapToPi(h.x(4));
+    h.P = P0;
+    for (int k = 0; k < kSteps; ++k) {
+      const Vector6d truth = step();
+      ekf.Predict(kDt, 1.0, &h);
+      const UpdateResult r = ekf.Update(Measure(MeasuredPose(kind, truth), R, rng), &h);
+      ASSERT_NE(r.reason, UpdateStatus::kInvalidMeasurement);
+      (*nees_sum)[k] += Nees(truth, h);
+    }
+  }
+}
+
+// The average NEES of a consistent filter: its mean over the steps within the 95% bounds, and at
+// least 80% of the steps inside them.
+void ExpectConsistent(const char* model, const std::vector<double>& nees_sum) {
+  const NeesFigures f = Summarise(nees_sum, kRuns);
+  std::printf("%s own motion: mean ANEES %.3f (95%% bounds per step [%.3f, %.3f]), %.0f%% of "
+              "steps inside\n",
+              model, f.mean_anees, f.lo, f.hi, 100.0 * f.fraction_inside);
+  EXPECT_GT(f.mean_anees, f.lo);
+  EXPECT_LT(f.mean_anees, f.hi);
+  EXPECT_GE(f.fraction_inside, 0.8);
+}
+
 // ISM on its own motion: the truth is the ISM's continuous white-acceleration model.
 TEST(MotionConsistency, IsmNeesWithinChiSquareBounds) {
   const Ekf ekf;
   const IsmParams& p = ekf.ism().params();
   std::mt19937_64 rng(2024);
-  const Eigen::Matrix3d R = MeasurementR(2.0);
   Matrix6d P0 = Matrix6d::Zero();
   P0.diagonal() << 0.09, 1.0, 0.09, 1.0, 0.0025, 0.01;
-  std::vector<double> nees_sum(kSteps, 0.0);
-  for (int run = 0; run < kRuns; ++run) {
-    Vector6d truth;
+  Vector6d truth;
+  const auto start = [&] {
     truth << 0.0, 6.0, 0.0, 3.0, 0.46, 0.05;
-    Hypothesis h;
-    h.x = truth + Sample<6>(P0, rng);
-    h.x(4) = WrapToPi(h.x(4));
-    h.P = P0;
-    for (int k = 0; k < kSteps; ++k) {
-      testing::StepIsmBody(kDt, 20, p.alpha, p.beta, rng, &truth);
-      ekf.Predict(kDt, 1.0, &h);
-      const UpdateResult r =
-          ekf.Update(Measure(Eigen::Vector3d(truth(0), truth(2), truth(4)), R, rng), &h);
-      ASSERT_NE(r.reason, UpdateStatus::kInvalidMeasurement);
-      nees_sum[k] += Nees(truth, h);
-    }
-  }
-  const NeesFigures f = Summarise(nees_sum, kRuns);
-  std::printf("ISM own motion: mean ANEES %.3f (95%% bounds per step [%.3f, %.3f]), %.0f%% of "
-              "steps inside\n",
-              f.mean_anees, f.lo, f.hi, 100.0 * f.fraction_inside);
-  EXPECT_GT(f.mean_anees, f.lo);
-  EXPECT_LT(f.mean_anees, f.hi);
-  EXPECT_GE(f.fraction_inside, 0.8);
+    return truth;
+  };
+  const auto step = [&] {
+    testing::StepIsmBody(kDt, 20, p.alpha, p.beta, rng, &truth);
+    return truth;
+  };
+  std::vector<double> nees_sum;
+  AddNees(ekf, ModelKind::kIsm, P0, start, step, rng, &nees_sum);
+  ASSERT_FALSE(HasFatalFailure());
+  ExpectConsistent("ISM", nees_sum);
 }
 
 // VASM on its own motion: a car (axis 1.4 m behind the centre) at 8 m/s whose yaw rate and
@@ -121,34 +152,23 @@ TEST(MotionConsistency, VasmNeesWithinChiSquareBounds) {
   vp.gamma = 0.05;  // yaw-rate std after 6 s: 0.55 rad/s
   const Ekf ekf(IsmParams(), vp);
   std::mt19937_64 rng(4048);
-  const Eigen::Matrix3d R = MeasurementR(2.0);
   Matrix6d P0 = Matrix6d::Zero();
   P0.diagonal() << 0.04, 0.04, 0.09, 0.25, 0.0025, 0.0025;
-  std::vector<double> nees_sum(kSteps, 0.0);
-  for (int run = 0; run < kRuns; ++run) {
-    Vector6d x0;
-    x0 << 0.0, 0.0, -1.4, 8.0, 0.3, 0.05;
-    AxisVehicle truth = AxisVehicle::FromVasmState(x0);
-    Hypothesis h;
-    h.kind = ModelKind::kVasm;
-    h.x = x0 + Sample<6>(P0, rng);
-    h.P = P0;
-    for (int k = 0; k < kSteps; ++k) {
-      testing::StepAxisVehicle(kDt, 20, vp.alpha, vp.gamma, vp.epsilon_L, rng, &truth);
-      const Vector6d xt = truth.VasmState();
-      ekf.Predict(kDt, 1.0, &h);
-      const UpdateResult r = ekf.Update(Measure(Eigen::Vector3d(xt(0), xt(1), xt(4)), R, rng), &h);
-      ASSERT_NE(r.reason, UpdateStatus::kInvalidMeasurement);
-      nees_sum[k] += Nees(xt, h);
-    }
-  }
-  const NeesFigures f = Summarise(nees_sum, kRuns);
-  std::printf("VASM own motion: mean ANEES %.3f (95%% bounds per step [%.3f, %.3f]), %.0f%% of "
-              "steps inside\n",
-              f.mean_anees, f.lo, f.hi, 100.0 * f.fraction_inside);
-  EXPECT_GT(f.mean_anees, f.lo);
-  EXPECT_LT(f.mean_anees, f.hi);
-  EXPECT_GE(f.fraction_inside, 0.8);
+  Vector6d x0;
+  x0 << 0.0, 0.0, -1.4, 8.0, 0.3, 0.05;
+  AxisVehicle truth;
+  const auto start = [&] {
+    truth = AxisVehicle::FromVasmState(x0);
+    return x0;
+  };
+  const auto step = [&] {
+    testing::StepAxisVehicle(kDt, 20, vp.alpha, vp.gamma, vp.epsilon_L, rng, &truth);
+    return truth.VasmState();
+  };
+  std::vector<double> nees_sum;
+  AddNees(ekf, ModelKind::kVasm, P0, start, step, rng, &nees_sum);
+  ASSERT_FALSE(HasFatalFailure());
+  ExpectConsistent("VASM", nees_sum);
 }
 
 // A car with Ackerman steering (rear axle 1.4 m behind the centre) at 6 m/s: 2 s straight, a 90

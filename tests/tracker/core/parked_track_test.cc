@@ -35,26 +35,43 @@ PointSet ParkedCorner(std::int64_t utime) {
 
 constexpr std::int64_t kStep = 100'000;  // [us] 10 Hz
 
-// Creates the parked car's track from its corner and updates it for 2 s with the same returns
-// (confirmed, not a mover). Returns the time of the last update.
-std::int64_t SeeParkedCornerFor2s(TrackManager* m, const Eigen::Vector2d& sensor) {
-  std::int64_t t = 1'000'000'000;
-  EXPECT_TRUE(m->Create(ParkedCorner(t), sensor, 1));
-  m->EndScan(t);
-  for (int k = 1; k <= 20; ++k) {
-    t += kStep;
-    m->Update(0, ParkedCorner(t), sensor, static_cast<std::uint64_t>(k), nullptr);
-    m->EndScan(t);
+// A track manager with the default parameters, the sensor at the origin, and the scans' clock.
+struct Scans {
+  const Ekf ekf;
+  const TrackManagerParams params;
+  TrackManager m{params, ekf, FitParams(), ShapeParams()};
+  const Eigen::Vector2d sensor{0.0, 0.0};
+  std::int64_t t = 1'000'000'000;  // [us] the current scan's time
+
+  // Scan 0, at t: a track is started from p. Returns whether it was.
+  bool Create(const PointSet& p) {
+    const bool created = m.Create(p, sensor, 1);
+    m.EndScan(t);
+    return created;
   }
-  return t;
+  // Scan k, at t: track 0 is measured by p.
+  void Update(int k, const PointSet& p) {
+    m.Update(0, p, sensor, static_cast<std::uint64_t>(k), nullptr);
+    m.EndScan(t);
+  }
+};
+
+// Creates the parked car's track from its corner and updates it for 2 s with the same returns
+// (confirmed, not a mover).
+void SeeParkedCornerFor2s(Scans* s) {
+  EXPECT_TRUE(s->Create(ParkedCorner(s->t)));
+  for (int k = 1; k <= 20; ++k) {
+    s->t += kStep;
+    s->Update(k, ParkedCorner(s->t));
+  }
 }
 
 TEST(ParkedTrackTest, MissedParkedTrackIsLookedForWhereItWasWithoutGateGrowthAndCoastsLonger) {
-  const Ekf ekf;
-  const TrackManagerParams params;
-  TrackManager m(params, ekf, FitParams(), ShapeParams());
-  const Eigen::Vector2d sensor(0.0, 0.0);
-  std::int64_t t = SeeParkedCornerFor2s(&m, sensor);
+  Scans s;
+  SeeParkedCornerFor2s(&s);
+  TrackManager& m = s.m;
+  const TrackManagerParams& params = s.params;
+  std::int64_t& t = s.t;
   ASSERT_EQ(m.tracks().size(), 1u);
   ASSERT_NE(m.tracks()[0].status, TrackStatus::kTentative);
   ASSERT_FALSE(m.tracks()[0].mover);
@@ -110,20 +127,16 @@ PointSet HiddenButForTheSidesWestEnd(std::int64_t utime) {
 }
 
 TEST(ParkedTrackTest, PartialViewOfAParkedCarKeepsItsTrackInPlace) {
-  const Ekf ekf;
-  const TrackManagerParams params;
-  TrackManager m(params, ekf, FitParams(), ShapeParams());
-  const Eigen::Vector2d sensor(0.0, 0.0);
-  std::int64_t t = SeeParkedCornerFor2s(&m, sensor);
-  ASSERT_EQ(m.tracks().size(), 1u);
-  ASSERT_FALSE(m.tracks()[0].mover);
+  Scans s;
+  SeeParkedCornerFor2s(&s);
+  ASSERT_EQ(s.m.tracks().size(), 1u);
+  ASSERT_FALSE(s.m.tracks()[0].mover);
   for (int k = 21; k <= 50; ++k) {  // 3 s of the partial view
-    t += kStep;
-    m.Update(0, HiddenButForTheSidesWestEnd(t), sensor, static_cast<std::uint64_t>(k), nullptr);
-    m.EndScan(t);
+    s.t += kStep;
+    s.Update(k, HiddenButForTheSidesWestEnd(s.t));
   }
-  ASSERT_EQ(m.tracks().size(), 1u);
-  const OrientedBox box = m.Box(0);
+  ASSERT_EQ(s.m.tracks().size(), 1u);
+  const OrientedBox box = s.m.Box(0);
   EXPECT_NEAR(box.center.x(), 20.0, 0.3);
   EXPECT_NEAR(box.center.y(), 5.0, 0.3);
 }
@@ -170,20 +183,13 @@ TEST(ParkedTrackTest, RearFaceSeenWholeBesideTheFirstMetreOfTheSideKeepsTheAxis)
   // The rear face seen whole (1.8 m) is an end: the track starts along the car. Then the first
   // 1.2 m of its side shows too: the shape's "width" (1.8) now exceeds 1.3 x its "length" (1.2
   // seen), and turning the axis by 90 deg (a side 1.8 m long) put the centre 1.4 m off.
-  const Ekf ekf;
-  const TrackManagerParams params;
-  TrackManager m(params, ekf, FitParams(), ShapeParams());
-  const Eigen::Vector2d sensor(0.0, 0.0);
-  std::int64_t t = 1'000'000'000;
-  ASSERT_TRUE(m.Create(RearView(t, -5.5, -3.7, 0.0), sensor, 1));
-  m.EndScan(t);
+  Scans s;
+  ASSERT_TRUE(s.Create(RearView(s.t, -5.5, -3.7, 0.0)));
   for (int k = 1; k <= 40; ++k) {
-    t += kStep;
-    m.Update(0, RearView(t, -5.5, -3.7, k <= 10 ? 0.0 : 26.95), sensor,
-             static_cast<std::uint64_t>(k), nullptr);
-    m.EndScan(t);
-    ASSERT_EQ(m.tracks().size(), 1u);
-    const OrientedBox box = m.Box(0);
+    s.t += kStep;
+    s.Update(k, RearView(s.t, -5.5, -3.7, k <= 10 ? 0.0 : 26.95));
+    ASSERT_EQ(s.m.tracks().size(), 1u);
+    const OrientedBox box = s.m.Box(0);
     EXPECT_LT(AxisErrorDeg(box.theta), 5.0) << "scan " << k;
     EXPECT_LT((box.center - Eigen::Vector2d(28.0, -4.6)).norm(), 0.5) << "scan " << k;
   }
@@ -195,23 +201,16 @@ TEST(ParkedTrackTest, FarCarFirstSeenAsAFewReturnsBecomesARectangleOnceItsRearFa
   // default length behind it. (Before: it stayed a centroid at the face, 2.25 m from the centre,
   // until the segment spanned 2 m; and the face, judged against a small object's 1 m width,
   // was taken for a side.)
-  const Ekf ekf;
-  const TrackManagerParams params;
-  TrackManager m(params, ekf, FitParams(), ShapeParams());
-  const Eigen::Vector2d sensor(0.0, 0.0);
-  std::int64_t t = 1'000'000'000;
-  ASSERT_TRUE(m.Create(RearView(t, -4.9, -4.3, 0.0), sensor, 1));
-  m.EndScan(t);
-  ASSERT_EQ(m.tracks().size(), 1u);
-  ASSERT_TRUE(m.tracks()[0].small_object);
+  Scans s;
+  ASSERT_TRUE(s.Create(RearView(s.t, -4.9, -4.3, 0.0)));
+  ASSERT_EQ(s.m.tracks().size(), 1u);
+  ASSERT_TRUE(s.m.tracks()[0].small_object);
   for (int k = 1; k <= 20; ++k) {
-    t += kStep;
+    s.t += kStep;
     const bool whole = k > 5;
-    m.Update(0, whole ? RearView(t, -5.5, -3.7, 0.0) : RearView(t, -4.9, -4.3, 0.0), sensor,
-             static_cast<std::uint64_t>(k), nullptr);
-    m.EndScan(t);
+    s.Update(k, whole ? RearView(s.t, -5.5, -3.7, 0.0) : RearView(s.t, -4.9, -4.3, 0.0));
   }
-  ExpectTheRearViewsCarAsOneRectangle(m);
+  ExpectTheRearViewsCarAsOneRectangle(s.m);
 }
 
 TEST(ParkedTrackTest, GrownSmallObjectWhoseFitFailsStaysASmallObjectUntilOneFits) {
@@ -225,16 +224,10 @@ TEST(ParkedTrackTest, GrownSmallObjectWhoseFitFailsStaysASmallObjectUntilOneFits
     p.outline = false;
     return p;
   };
-  const Ekf ekf;
-  const TrackManagerParams params;
-  const FitParams fit_params;
-  ASSERT_EQ(fit_params.min_points, 5);
-  TrackManager m(params, ekf, fit_params, ShapeParams());
-  const Eigen::Vector2d sensor(0.0, 0.0);
-  std::int64_t t = 1'000'000'000;
-  ASSERT_TRUE(m.Create(view(t, -4.9, -4.3), sensor, 1));
-  m.EndScan(t);
-  ASSERT_TRUE(m.tracks()[0].small_object);
+  ASSERT_EQ(FitParams().min_points, 5);  // the fit parameters of Scans
+  Scans s;
+  ASSERT_TRUE(s.Create(view(s.t, -4.9, -4.3)));
+  ASSERT_TRUE(s.m.tracks()[0].small_object);
   const auto sparse = [&view](std::int64_t utime) {  // 4 returns over the whole rear face
     PointSet p = view(utime, -5.5, -3.7);
     PointSet q = p;
@@ -246,27 +239,25 @@ TEST(ParkedTrackTest, GrownSmallObjectWhoseFitFailsStaysASmallObjectUntilOneFits
     }
     return q;
   };
-  ASSERT_EQ(sparse(t).size(), 4u);
-  ASSERT_GE(sparse(t).extent, params.small_object_grown_extent);
+  ASSERT_EQ(sparse(s.t).size(), 4u);
+  ASSERT_GE(sparse(s.t).extent, s.params.small_object_grown_extent);
   int k = 1;
   for (; k <= 10; ++k) {
-    t += kStep;
-    m.Update(0, sparse(t), sensor, static_cast<std::uint64_t>(k), nullptr);
-    m.EndScan(t);
-    ASSERT_EQ(m.tracks().size(), 1u) << "scan " << k;
-    EXPECT_TRUE(m.tracks()[0].small_object) << "scan " << k;
-    EXPECT_EQ(m.tracks()[0].hyps.size(), 1u) << "scan " << k;
+    s.t += kStep;
+    s.Update(k, sparse(s.t));
+    ASSERT_EQ(s.m.tracks().size(), 1u) << "scan " << k;
+    EXPECT_TRUE(s.m.tracks()[0].small_object) << "scan " << k;
+    EXPECT_EQ(s.m.tracks()[0].hyps.size(), 1u) << "scan " << k;
   }
   // Measured by the centroid of the returns: on the rear face, near its middle.
-  const OrientedBox small = m.Box(0);
+  const OrientedBox small = s.m.Box(0);
   EXPECT_NEAR(small.center.x(), 25.75, 0.3);
   EXPECT_NEAR(small.center.y(), -4.6, 0.4);
   for (; k <= 25; ++k) {
-    t += kStep;
-    m.Update(0, view(t, -5.5, -3.7), sensor, static_cast<std::uint64_t>(k), nullptr);
-    m.EndScan(t);
+    s.t += kStep;
+    s.Update(k, view(s.t, -5.5, -3.7));
   }
-  ExpectTheRearViewsCarAsOneRectangle(m);
+  ExpectTheRearViewsCarAsOneRectangle(s.m);
 }
 
 }  // namespace

@@ -45,12 +45,21 @@ Cloud RearFace() {
 const Eigen::Vector2d kSensor(0.0, 0.0);
 const Eigen::Vector2d kLeft(40.0, 0.9), kRight(40.0, -0.9);
 
-TEST(RangeProfileTest, FaceEndingInFreeSpaceIsSeenWhole) {
-  const Cloud c = RearFace();
+// The profile of c, per ring.
+RangeProfile PerRing(const Cloud& c) {
   RangeProfile p;
   p.Build(kSensor, c.x, c.y, c.ring, kBinDeg);
-  EXPECT_TRUE(p.FreeBeyond(kLeft, kRight, kMargin, kBins));
-  EXPECT_TRUE(p.FreeBeyond(kRight, kLeft, kMargin, kBins));
+  return p;
+}
+
+// Whether the rear face's left (right) end is seen free beyond it in p.
+bool LeftEndFree(const RangeProfile& p) { return p.FreeBeyond(kLeft, kRight, kMargin, kBins); }
+bool RightEndFree(const RangeProfile& p) { return p.FreeBeyond(kRight, kLeft, kMargin, kBins); }
+
+TEST(RangeProfileTest, FaceEndingInFreeSpaceIsSeenWhole) {
+  const RangeProfile p = PerRing(RearFace());
+  EXPECT_TRUE(LeftEndFree(p));
+  EXPECT_TRUE(RightEndFree(p));
 }
 
 TEST(RangeProfileTest, LowObjectNearTheSensorOnOtherRingsDoesNotHideTheFace) {
@@ -58,15 +67,14 @@ TEST(RangeProfileTest, LowObjectNearTheSensorOnOtherRingsDoesNotHideTheFace) {
   // the downward rings 0-5: the rings that see the face pass over it.
   Cloud c = RearFace();
   c.Face(4.0, -0.8, 0.8, 0, 5);
-  RangeProfile per_ring;
-  per_ring.Build(kSensor, c.x, c.y, c.ring, kBinDeg);
-  EXPECT_TRUE(per_ring.FreeBeyond(kLeft, kRight, kMargin, kBins));
-  EXPECT_TRUE(per_ring.FreeBeyond(kRight, kLeft, kMargin, kBins));
+  const RangeProfile per_ring = PerRing(c);
+  EXPECT_TRUE(LeftEndFree(per_ring));
+  EXPECT_TRUE(RightEndFree(per_ring));
   // One profile over all rings (as before) reads the bonnet as an occluder beyond both ends.
   RangeProfile flat;
   flat.Build(kSensor, c.x, c.y, kBinDeg);
-  EXPECT_FALSE(flat.FreeBeyond(kLeft, kRight, kMargin, kBins));
-  EXPECT_FALSE(flat.FreeBeyond(kRight, kLeft, kMargin, kBins));
+  EXPECT_FALSE(LeftEndFree(flat));
+  EXPECT_FALSE(RightEndFree(flat));
 }
 
 TEST(RangeProfileTest, OccluderOnTheFaceRingsJustBeyondAnEndHidesIt) {
@@ -76,10 +84,9 @@ TEST(RangeProfileTest, OccluderOnTheFaceRingsJustBeyondAnEndHidesIt) {
   for (double d = -0.05; d <= 0.05; d += 0.01) {
     c.Add(20.0 * std::cos(bearing + d / 20.0), 20.0 * std::sin(bearing + d / 20.0), 32);
   }
-  RangeProfile p;
-  p.Build(kSensor, c.x, c.y, c.ring, kBinDeg);
-  EXPECT_FALSE(p.FreeBeyond(kLeft, kRight, kMargin, kBins));
-  EXPECT_TRUE(p.FreeBeyond(kRight, kLeft, kMargin, kBins));  // the other end is still free
+  const RangeProfile p = PerRing(c);
+  EXPECT_FALSE(LeftEndFree(p));
+  EXPECT_TRUE(RightEndFree(p));  // the other end is still free
 }
 
 TEST(RangeProfileTest, FaceContinuingAtTheSameRangeIsNotSeenWhole) {
@@ -87,10 +94,9 @@ TEST(RangeProfileTest, FaceContinuingAtTheSameRangeIsNotSeenWhole) {
   // part of it.
   Cloud c = RearFace();
   c.Face(40.0, -1.5, -0.95, 31, 31);
-  RangeProfile p;
-  p.Build(kSensor, c.x, c.y, c.ring, kBinDeg);
-  EXPECT_FALSE(p.FreeBeyond(kRight, kLeft, kMargin, kBins));
-  EXPECT_TRUE(p.FreeBeyond(kLeft, kRight, kMargin, kBins));
+  const RangeProfile p = PerRing(c);
+  EXPECT_FALSE(RightEndFree(p));
+  EXPECT_TRUE(LeftEndFree(p));
 }
 
 TEST(RangeProfileTest, RingsOutsideTheTableShareTheLastAndNegativeOnesTheFirst) {
@@ -98,9 +104,7 @@ TEST(RangeProfileTest, RingsOutsideTheTableShareTheLastAndNegativeOnesTheFirst) 
   Cloud c = RearFace();
   c.Add(4.0, 0.0, -3);
   c.Add(4.0, 0.1, 30000);
-  RangeProfile p;
-  p.Build(kSensor, c.x, c.y, c.ring, kBinDeg);
-  EXPECT_TRUE(p.FreeBeyond(kLeft, kRight, kMargin, kBins));
+  EXPECT_TRUE(LeftEndFree(PerRing(c)));
 }
 
 }  // namespace

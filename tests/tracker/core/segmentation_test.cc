@@ -9,6 +9,7 @@
 #include <set>
 
 #include "base/angle.h"
+#include "tests/support/params_check.h"
 
 namespace vtrack {
 namespace {
@@ -126,11 +127,9 @@ TEST(SegmentationTest, SmallAndHugeSegmentsAreDropped) {
 
 TEST(SegmentationTest, ValidateNamesTheKey) {
   SegmentationParams p;
-  std::string error;
-  EXPECT_TRUE(p.Validate(&error));
+  EXPECT_TRUE(testing::Accepted(p));
   p.connectivity = 6;
-  EXPECT_FALSE(p.Validate(&error));
-  EXPECT_NE(error.find("connectivity = 6"), std::string::npos);
+  EXPECT_TRUE(testing::RefusedSaying(p, {"connectivity = 6"}));
 }
 
 }  // namespace

@@ -10,6 +10,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "tests/support/grid.h"
+#include "tests/support/params_check.h"
 #include "tests/tracker/core/jacobian_check.h"
 #include "tests/tracker/core/motion_truth.h"
 #include "base/angle.h"
@@ -18,6 +20,8 @@ namespace vtrack {
 namespace {
 
 using testing::AxisVehicle;
+using testing::ForEachCombination;
+using testing::With;
 using testing::JacobianCheckOptions;
 using testing::JacobianMatchesCentralDifferences;
 
@@ -222,11 +226,17 @@ double WorstDeviation(const McResult& mc, const Matrix6d& Q, std::string* where)
   return worst;
 }
 
-TEST(Vasm, ProcessNoiseMatchesMonteCarloOfContinuousNoiseModel) {
+// The noise intensities the Monte Carlo comparisons of Q below simulate.
+VasmParams MonteCarloNoise() {
   VasmParams p;
   p.alpha = 0.01;
   p.gamma = 0.001;
   p.epsilon_L = 0.002;
+  return p;
+}
+
+TEST(Vasm, ProcessNoiseMatchesMonteCarloOfContinuousNoiseModel) {
+  const VasmParams p = MonteCarloNoise();
   const VasmModel model(p);
   struct Case {
     double v, L, dt;
@@ -270,10 +280,7 @@ TEST(Vasm, ProcessNoiseMatchesMonteCarloOfContinuousNoiseModel) {
 // (vasm.h). At urban yaw rates and 10 Hz they are resolved by the Monte Carlo: with them Q is
 // inside the statistical bounds, without them (the straight-motion Q) it is not.
 TEST(Vasm, ProcessNoiseMatchesMonteCarloWhileTurning) {
-  VasmParams p;
-  p.alpha = 0.01;
-  p.gamma = 0.001;
-  p.epsilon_L = 0.002;
+  const VasmParams p = MonteCarloNoise();
   const VasmModel model(p);
   struct Case {
     double v, theta_dot;
@@ -300,24 +307,18 @@ TEST(Vasm, ProcessNoiseMatchesMonteCarloWhileTurning) {
 
 TEST(Vasm, ProcessNoiseIsSymmetricPositiveSemiDefinite) {
   const VasmModel model;
-  int checked = 0;
-  for (double dt : {0.0, 0.01, 0.1, 0.5, 2.0}) {
-    for (double v : {0.0, 12.0, -5.0}) {
-      for (double L : {0.0, -1.5, 3.0}) {
-        for (double theta_dot : {0.0, 0.3, -2.0}) {
-          Vector6d x;
-          x << 0.0, 0.0, L, v, 1.0, theta_dot;
-          const Matrix6d Q = model.ProcessNoise(x, dt);
-          EXPECT_EQ((Q - Q.transpose()).cwiseAbs().maxCoeff(), 0.0);
-          const Eigen::SelfAdjointEigenSolver<Matrix6d> eig(Q);
-          EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-13 * std::max(1e-300, Q.norm()))
-              << "dt " << dt << " v " << v << " L " << L << " theta_dot " << theta_dot << "\n"
-              << Q;
-          ++checked;
-        }
-      }
-    }
-  }
+  const int checked = ForEachCombination(
+      {0.0, 0.01, 0.1, 0.5, 2.0}, {0.0, 12.0, -5.0}, {0.0, -1.5, 3.0}, {0.0, 0.3, -2.0},
+      [&](double dt, double v, double L, double theta_dot) {
+        Vector6d x;
+        x << 0.0, 0.0, L, v, 1.0, theta_dot;
+        const Matrix6d Q = model.ProcessNoise(x, dt);
+        EXPECT_EQ((Q - Q.transpose()).cwiseAbs().maxCoeff(), 0.0);
+        const Eigen::SelfAdjointEigenSolver<Matrix6d> eig(Q);
+        EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-13 * std::max(1e-300, Q.norm()))
+            << "dt " << dt << " v " << v << " L " << L << " theta_dot " << theta_dot << "\n"
+            << Q;
+      });
   EXPECT_EQ(checked, 5 * 3 * 3 * 3);
 }
 
@@ -353,20 +354,11 @@ TEST(Vasm, AtAxisPointQIsEq12WithSignedV) {
 }
 
 TEST(Vasm, ParamsValidationNamesFieldAndValue) {
-  std::string error;
-  EXPECT_TRUE(VasmParams().Validate(&error)) << error;
-  VasmParams p;
-  p.epsilon_L = -0.01;
-  EXPECT_FALSE(p.Validate(&error));
-  EXPECT_NE(error.find("epsilon_L"), std::string::npos) << error;
-  EXPECT_NE(error.find("-0.01"), std::string::npos) << error;
-  p = VasmParams();
-  p.gamma = std::numeric_limits<double>::infinity();
-  EXPECT_FALSE(p.Validate(&error));
-  EXPECT_NE(error.find("gamma"), std::string::npos) << error;
-  p = VasmParams();
-  p.initial_L_std = 0.0;
-  EXPECT_THROW(VasmModel{p}, std::invalid_argument);
+  EXPECT_TRUE(testing::Accepted(VasmParams()));
+  EXPECT_TRUE(testing::RefusedSaying(With(&VasmParams::epsilon_L, -0.01), {"epsilon_L", "-0.01"}));
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_TRUE(testing::RefusedSaying(With(&VasmParams::gamma, inf), {"gamma"}));
+  EXPECT_THROW(VasmModel{With(&VasmParams::initial_L_std, 0.0)}, std::invalid_argument);
 }
 
 }  // namespace

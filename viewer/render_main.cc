@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "lcmtypes/util/command_line.h"
 #include "lcmtypes/util/process.h"
 #include "viewer/frame_output.h"
 #include "viewer/live_render.h"
@@ -153,7 +154,7 @@ int main(int argc, char** argv) {
       "vtrack-render: top-down frames of LADAR scans, tracks and ground truth in the style of the\n"
       "paper's Figure 4, written to an MP4 video and PNG snapshots (viewer/README.md).\n\n"
       "  offline: vtrack-render --input run.lcm --input tracks.lcm --video out.mp4 --png-dir png/\n"
-      "  live:    vtrack-render --video live.mp4 --png-dir png/    (Ctrl-C to stop)\n";
+      "  live:    vtrack-render --video live.mp4 --png-dir png/    (Ctrl-C to stop)";
   po::options_description all;
   all.add(general).add(out).add(view).add(frames);
   po::positional_options_description positional;
@@ -161,12 +162,11 @@ int main(int argc, char** argv) {
 
   po::variables_map vm;
   try {
-    po::store(po::command_line_parser(argc, argv).options(all).positional(positional).run(), vm);
-    if (vm.count("help")) {
-      std::cout << usage << "\n" << all << "\n";
+    if (!vtrack::lcm_util::StoreCommandLine(
+            po::command_line_parser(argc, argv).options(all).positional(positional).run(), all, &vm,
+            usage)) {
       return 0;
     }
-    po::notify(vm);
 
     // View.
     {

@@ -1,6 +1,6 @@
 #include "sensor_driver/driver/sim_cli.h"
 
-#include <iostream>
+#include "lcmtypes/util/command_line.h"
 
 namespace vtrack::sim {
 
@@ -81,13 +81,8 @@ std::unique_ptr<Simulator> MakeSimulator(const SimCli& cli) {
 
 bool ParseCommandLine(int argc, char** argv, const po::options_description& desc,
                       const std::string& usage, po::variables_map* vm) {
-  po::store(po::command_line_parser(argc, argv).options(desc).run(), *vm);
-  if (vm->count("help")) {
-    std::cout << usage << "\n\n" << desc << "\n";
-    return false;
-  }
-  po::notify(*vm);
-  return true;
+  return lcm_util::StoreCommandLine(po::command_line_parser(argc, argv).options(desc).run(), desc,
+                                   vm, usage);
 }
 
 }  // namespace vtrack::sim

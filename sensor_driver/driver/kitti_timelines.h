@@ -31,7 +31,7 @@ class KittiScanTimeline : public Timeline {
   std::int64_t PublishOffsetUs(int i) const override;
   void Prepare(int i, std::int64_t lap_start_utime, std::int64_t lap) override;
   void Publish() override;
-  std::int64_t LapUs() const;
+  std::int64_t LapUs() const override;
 
  private:
   std::unique_ptr<kitti::Sequence> seq_;
@@ -52,7 +52,7 @@ class KittiPoseTimeline : public Timeline {
   std::int64_t PublishOffsetUs(int k) const override;
   void Prepare(int k, std::int64_t lap_start_utime, std::int64_t lap) override;
   void Publish() override;
-  std::int64_t LapUs() const;
+  std::int64_t LapUs() const override;
 
  private:
   std::unique_ptr<kitti::Sequence> seq_;

@@ -1,5 +1,7 @@
 #include "sensor_driver/driver/sim_cli.h"
 
+#include <cstdio>
+
 #include "lcmtypes/util/command_line.h"
 
 namespace vtrack::sim {
@@ -83,6 +85,21 @@ bool ParseCommandLine(int argc, char** argv, const po::options_description& desc
                       const std::string& usage, po::variables_map* vm) {
   return lcm_util::StoreCommandLine(po::command_line_parser(argc, argv).options(desc).run(), desc,
                                    vm, usage);
+}
+
+std::optional<int> ParseSimCommandLine(int argc, char** argv, const po::options_description& desc,
+                                       const std::string& usage, const char* name,
+                                       const std::function<void(const po::variables_map&)>& check,
+                                       po::variables_map* vm, SimCli* cli) {
+  try {
+    if (!ParseCommandLine(argc, argv, desc, usage, vm)) return 0;
+    *cli = ReadSimCli(*vm);
+    if (check) check(*vm);
+  } catch (const po::error& e) {
+    std::fprintf(stderr, "%s: %s (see --help)\n", name, e.what());
+    return 2;
+  }
+  return std::nullopt;
 }
 
 }  // namespace vtrack::sim

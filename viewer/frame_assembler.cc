@@ -40,12 +40,6 @@ void PruneTrail(TimedPath* path, std::int64_t from) {
 
 }  // namespace
 
-bool AssemblerParams::Validate(std::string* error) const {
-  const std::string problem = FirstProblem();
-  if (error) *error = problem;
-  return problem.empty();
-}
-
 std::string AssemblerParams::FirstProblem() const {
   std::ostringstream os;
   auto bad = [&](const char* key, double v, const char* what) {

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "base/pose.h"
+#include "viewer/validate.h"
 #include "vtrack/ladar_scan_t.hpp"
 #include "vtrack/object_list_t.hpp"
 #include "vtrack/pose_t.hpp"
@@ -52,7 +53,7 @@ struct AssemblerParams {
   std::int64_t pose_span_us = 5'000'000;    // [us] ego poses kept for motion compensation
 
   // True if every field is valid; otherwise false and *error names the key and its value.
-  bool Validate(std::string* error) const;
+  bool Validate(std::string* error) const { return ValidateByFirstProblem(*this, error); }
   std::string FirstProblem() const;  // "" if valid
 };
 

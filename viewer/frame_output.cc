@@ -19,12 +19,6 @@ constexpr double kDefaultFps = 10.0;    // [1/s] if the rate cannot be estimated
 
 }  // namespace
 
-bool OutputParams::Validate(std::string* error) const {
-  const std::string problem = FirstProblem();
-  if (error) *error = problem;
-  return problem.empty();
-}
-
 std::string OutputParams::FirstProblem() const {
   std::ostringstream os;
   if (!(fps >= 0.0) || !std::isfinite(fps) || fps > 1000.0) {

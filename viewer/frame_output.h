@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include "viewer/validate.h"
+
 namespace vtrack::viewer {
 
 struct OutputParams {
@@ -22,7 +24,7 @@ struct OutputParams {
                                    //     (seconds since the first frame of the run)
 
   // True if every field is valid; otherwise false and *error names the key and its value.
-  bool Validate(std::string* error) const;
+  bool Validate(std::string* error) const { return ValidateByFirstProblem(*this, error); }
   std::string FirstProblem() const;  // "" if valid
 };
 

@@ -7,12 +7,6 @@
 
 namespace vtrack::viewer {
 
-bool Channels::Validate(std::string* error) const {
-  const std::string problem = FirstProblem();
-  if (error) *error = problem;
-  return problem.empty();
-}
-
 std::string Channels::FirstProblem() const {
   const std::pair<const char*, const std::string*> all[] = {
       {"scan_channel", &scan}, {"pose_channel", &pose}, {"tracks_channel", &tracks},

@@ -10,6 +10,7 @@
 
 #include "lcmtypes/util/process.h"
 #include "viewer/frame_assembler.h"
+#include "viewer/validate.h"
 
 namespace vtrack::viewer {
 
@@ -22,7 +23,7 @@ struct Channels {
   std::string truth = "GROUND_TRUTH";
 
   // True if every field is valid; otherwise false and *error names the key and its value.
-  bool Validate(std::string* error) const;
+  bool Validate(std::string* error) const { return ValidateByFirstProblem(*this, error); }
   std::string FirstProblem() const;  // "" if valid
 };
 

@@ -5,12 +5,6 @@
 
 namespace vtrack::viewer {
 
-bool RenderJob::Validate(std::string* error) const {
-  const std::string problem = FirstProblem();
-  if (error) *error = problem;
-  return problem.empty();
-}
-
 std::string RenderJob::FirstProblem() const {
   for (const std::string& err : {channels.FirstProblem(), assembler.FirstProblem(),
                                  scene.FirstProblem(), render.FirstProblem()}) {

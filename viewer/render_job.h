@@ -9,6 +9,7 @@
 #include "viewer/message_router.h"
 #include "viewer/renderer.h"
 #include "viewer/scene_builder.h"
+#include "viewer/validate.h"
 
 namespace vtrack::viewer {
 
@@ -23,7 +24,7 @@ struct RenderJob {
   std::int64_t max_frames = 0;                              // [-] stop after this many; 0 = all
 
   // True if every field is valid; otherwise false and *error names the key and its value.
-  bool Validate(std::string* error) const;
+  bool Validate(std::string* error) const { return ValidateByFirstProblem(*this, error); }
   std::string FirstProblem() const;  // "" if valid
 };
 

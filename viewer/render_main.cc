@@ -7,12 +7,14 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
-#include <sstream>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "lcmtypes/util/command_line.h"
 #include "lcmtypes/util/process.h"
+#include "lcmtypes/util/text.h"
 #include "viewer/frame_output.h"
 #include "viewer/live_render.h"
 #include "viewer/offline_render.h"
@@ -32,28 +34,16 @@ struct UsageError : std::runtime_error {
 
 std::vector<double> ParseNumbers(const std::string& option, const std::string& text,
                                  char separator, std::size_t expected = 0) {
-  std::vector<double> out;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, separator)) {
-    std::size_t used = 0;
-    double v = 0.0;
-    try {
-      v = std::stod(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != item.size() || !std::isfinite(v)) {
-      throw UsageError("--" + option + " '" + text + "': '" + item + "' is not a number");
-    }
-    out.push_back(v);
-  }
-  if (out.empty() || (expected > 0 && out.size() != expected)) {
+  std::string bad;
+  const std::optional<std::vector<double>> out =
+      vtrack::lcm_util::ParseNumberList(text, separator, /*finite_only=*/true, &bad);
+  if (!out) throw UsageError("--" + option + " '" + text + "': '" + bad + "' is not a number");
+  if (out->empty() || (expected > 0 && out->size() != expected)) {
     throw UsageError("--" + option + " '" + text + "': expected " +
                      (expected > 0 ? std::to_string(expected) : std::string("one or more")) +
                      " numbers separated by '" + separator + "'");
   }
-  return out;
+  return *out;
 }
 
 std::int64_t Microseconds(double seconds) {
@@ -153,7 +143,7 @@ int main(int argc, char** argv) {
       "vtrack-render: top-down frames of LADAR scans, tracks and ground truth in the style of the\n"
       "paper's Figure 4, written to an MP4 video and PNG snapshots (viewer/README.md).\n\n"
       "  offline: vtrack-render --input run.lcm --input tracks.lcm --video out.mp4 --png-dir png/\n"
-      "  live:    vtrack-render --video live.mp4 --png-dir png/    (Ctrl-C to stop)\n";
+      "  live:    vtrack-render --video live.mp4 --png-dir png/    (Ctrl-C to stop)";
   po::options_description all;
   all.add(general).add(out).add(view).add(frames);
   po::positional_options_description positional;
@@ -161,12 +151,11 @@ int main(int argc, char** argv) {
 
   po::variables_map vm;
   try {
-    po::store(po::command_line_parser(argc, argv).options(all).positional(positional).run(), vm);
-    if (vm.count("help")) {
-      std::cout << usage << "\n" << all << "\n";
+    if (!vtrack::lcm_util::StoreCommandLine(
+            po::command_line_parser(argc, argv).options(all).positional(positional).run(), all, &vm,
+            usage)) {
       return 0;
     }
-    po::notify(vm);
 
     // View.
     {

@@ -471,12 +471,6 @@ class LabelPlacer {
 
 }  // namespace
 
-bool RenderParams::Validate(std::string* error) const {
-  const std::string problem = FirstProblem();
-  if (error) *error = problem;
-  return problem.empty();
-}
-
 std::string RenderParams::FirstProblem() const {
   if (width < 64 || width > 8192 || width % 2 != 0)
     return Bad("width", width, "must be even and in [64, 8192] px");

@@ -27,6 +27,7 @@
 #include <string>
 
 #include "viewer/scene.h"
+#include "viewer/validate.h"
 #include "viewer/view.h"
 
 namespace vtrack::viewer {
@@ -74,7 +75,7 @@ struct RenderParams {
   bool antialias = true;              // [-] anti-aliased lines and text
 
   // True if every field is valid; otherwise false and *error names the key and its value.
-  bool Validate(std::string* error) const;
+  bool Validate(std::string* error) const { return ValidateByFirstProblem(*this, error); }
   std::string FirstProblem() const;  // "" if valid
 };
 

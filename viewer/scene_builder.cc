@@ -20,12 +20,6 @@ std::string FormatSeconds(double s) {
 
 }  // namespace
 
-bool SceneParams::Validate(std::string* error) const {
-  const std::string problem = FirstProblem();
-  if (error) *error = problem;
-  return problem.empty();
-}
-
 std::string SceneParams::FirstProblem() const {
   if (std::string err = param::FirstProblem(preprocess); !err.empty()) return err;
   std::ostringstream os;

@@ -10,6 +10,7 @@
 #include "tracker/core/preprocess.h"
 #include "viewer/frame_assembler.h"
 #include "viewer/scene.h"
+#include "viewer/validate.h"
 
 namespace vtrack::viewer {
 
@@ -22,7 +23,7 @@ struct SceneParams {
   double ego_center_ahead = 0.0;                    // [m] outline centre ahead of the body origin
 
   // True if every field is valid; otherwise false and *error names the key and its value.
-  bool Validate(std::string* error) const;
+  bool Validate(std::string* error) const { return ValidateByFirstProblem(*this, error); }
   std::string FirstProblem() const;  // "" if valid
 };
 

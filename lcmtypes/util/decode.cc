@@ -2,6 +2,7 @@
 
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "vtrack/detection_list_t.hpp"
 #include "vtrack/detection_t.hpp"
@@ -94,6 +95,12 @@ class Walker {
     }
     return true;
   }
+  // An array field: its length, then count elements of elem_bytes each.
+  bool SkipArray(std::size_t elem_bytes, const char* count_field, const char* elems_field) {
+    std::int32_t n = 0;
+    return ReadCount(&n, elem_bytes, count_field) &&
+           Skip(static_cast<std::size_t>(n) * elem_bytes, elems_field);
+  }
   bool Fail(const char* field, const std::string& what) {
     if (why_) *why_ = std::string(field) + ": " + what;
     return false;
@@ -108,73 +115,65 @@ class Walker {
 
 constexpr std::size_t kMinStringBytes = 5;  // int32 length + NUL
 
-bool WalkLadarScan(Walker& w) {
+// An array field of variable-size elements, each at least min_elem_bytes long, walked by walk.
+bool WalkArray(Walker& w, std::size_t min_elem_bytes, const char* count_field,
+               bool (*walk)(Walker&)) {
   std::int32_t n = 0;
+  if (!w.ReadCount(&n, min_elem_bytes, count_field)) return false;
+  for (std::int32_t i = 0; i < n; ++i) {
+    if (!walk(w)) return false;
+  }
+  return true;
+}
+
+// A message type without variable-length fields.
+template <class T>
+bool WalkFixed(Walker& w) {
+  return w.Skip(FixedSize<T>(), T::getTypeName());
+}
+
+bool WalkLadarScan(Walker& w) {
   return w.Skip(8 + 8, "ladar_scan_t.utime/seq") && w.SkipString("ladar_scan_t.sensor_id") &&
          w.Skip(24 + 32 + 4 + 4 + 2, "ladar_scan_t.mounting") &&
-         w.ReadCount(&n, 4 * 4 + 4 + 2, "ladar_scan_t.npoints") &&
-         w.Skip(static_cast<std::size_t>(n) * 22, "ladar_scan_t.points");
+         w.SkipArray(4 * 4 + 4 + 2, "ladar_scan_t.npoints", "ladar_scan_t.points");
 }
 
 bool WalkObjectList(Walker& w) {
-  std::int32_t n = 0;
-  const std::size_t obj = FixedSize<object_t>();
   return w.Skip(8 + 8, "object_list_t.utime/scan_seq") && w.SkipString("object_list_t.source") &&
-         w.ReadCount(&n, obj, "object_list_t.num_objects") &&
-         w.Skip(static_cast<std::size_t>(n) * obj, "object_list_t.objects");
+         w.SkipArray(FixedSize<object_t>(), "object_list_t.num_objects", "object_list_t.objects");
 }
 
 bool WalkDetectionList(Walker& w) {
-  std::int32_t n = 0;
-  const std::size_t det = FixedSize<detection_t>();
   return w.Skip(8 + 8, "detection_list_t.utime/seq") && w.SkipString("detection_list_t.source") &&
-         w.ReadCount(&n, det, "detection_list_t.num_detections") &&
-         w.Skip(static_cast<std::size_t>(n) * det, "detection_list_t.detections");
+         w.SkipArray(FixedSize<detection_t>(), "detection_list_t.num_detections",
+                     "detection_list_t.detections");
 }
 
 bool WalkTrack(Walker& w) {
   // Everything before npred is fixed: the default message (npred = 0) minus the npred field.
   const std::size_t head = FixedSize<track_t>() - 4;
-  std::int32_t n = 0;
-  return w.Skip(head, "track_t.fields") && w.ReadCount(&n, 4 + 8 + 8 + 4 + 4, "track_t.npred") &&
-         w.Skip(static_cast<std::size_t>(n) * 28, "track_t.pred");
+  return w.Skip(head, "track_t.fields") &&
+         w.SkipArray(4 + 8 + 8 + 4 + 4, "track_t.npred", "track_t.pred");
 }
 
 bool WalkTrackList(Walker& w) {
-  std::int32_t n = 0;
-  if (!(w.Skip(8 + 8 + 8, "track_list_t.utime/scan_seq/latency") &&
-        w.SkipString("track_list_t.mode") &&
-        w.ReadCount(&n, FixedSize<track_t>(), "track_list_t.num_tracks"))) {
-    return false;
-  }
-  for (std::int32_t i = 0; i < n; ++i) {
-    if (!WalkTrack(w)) return false;
-  }
-  return true;
+  return w.Skip(8 + 8 + 8, "track_list_t.utime/scan_seq/latency") &&
+         w.SkipString("track_list_t.mode") &&
+         WalkArray(w, FixedSize<track_t>(), "track_list_t.num_tracks", WalkTrack);
 }
 
 bool WalkDebugEntry(Walker& w) {
-  std::int32_t edges = 0, points = 0, hyps = 0;
-  const std::size_t hyp = FixedSize<hypothesis_t>();
   return w.Skip(8 + 1 + 24 + 72 + 40 + 40 + 72 + 1 + 32, "track_debug_entry_t.fields") &&
-         w.ReadCount(&edges, 32, "track_debug_entry_t.num_edges") &&
-         w.Skip(static_cast<std::size_t>(edges) * 32, "track_debug_entry_t.edges") &&
-         w.ReadCount(&points, 9, "track_debug_entry_t.num_points") &&
-         w.Skip(static_cast<std::size_t>(points) * 9, "track_debug_entry_t.points") &&
-         w.ReadCount(&hyps, hyp, "track_debug_entry_t.num_hypotheses") &&
-         w.Skip(static_cast<std::size_t>(hyps) * hyp, "track_debug_entry_t.hypotheses");
+         w.SkipArray(32, "track_debug_entry_t.num_edges", "track_debug_entry_t.edges") &&
+         w.SkipArray(9, "track_debug_entry_t.num_points", "track_debug_entry_t.points") &&
+         w.SkipArray(FixedSize<hypothesis_t>(), "track_debug_entry_t.num_hypotheses",
+                     "track_debug_entry_t.hypotheses");
 }
 
 bool WalkTrackDebug(Walker& w) {
-  std::int32_t n = 0;
-  if (!(w.Skip(8 + 8 + 4, "track_debug_t.utime/scan_seq/num_segments") &&
-        w.ReadCount(&n, FixedSize<track_debug_entry_t>(), "track_debug_t.num_entries"))) {
-    return false;
-  }
-  for (std::int32_t i = 0; i < n; ++i) {
-    if (!WalkDebugEntry(w)) return false;
-  }
-  return true;
+  return w.Skip(8 + 8 + 4, "track_debug_t.utime/scan_seq/num_segments") &&
+         WalkArray(w, FixedSize<track_debug_entry_t>(), "track_debug_t.num_entries",
+                   WalkDebugEntry);
 }
 
 bool WalkTrackerStatus(Walker& w) {
@@ -191,6 +190,30 @@ bool WalkTrackerStatus(Walker& w) {
          w.Skip(8 + 8 + 3 * 4, "tracker_status_t.latency/tracks");
 }
 
+// Every vtrack message type with the walk of its encoding.
+struct MessageLayout {
+  std::int64_t fingerprint;
+  bool (*walk)(Walker&);
+};
+
+const std::vector<MessageLayout>& Layouts() {
+  static const std::vector<MessageLayout> layouts = {
+      {ladar_scan_t::getHash(), WalkLadarScan},
+      {object_list_t::getHash(), WalkObjectList},
+      {detection_list_t::getHash(), WalkDetectionList},
+      {detection_t::getHash(), WalkFixed<detection_t>},
+      {track_t::getHash(), WalkTrack},
+      {track_list_t::getHash(), WalkTrackList},
+      {track_debug_entry_t::getHash(), WalkDebugEntry},
+      {track_debug_t::getHash(), WalkTrackDebug},
+      {tracker_status_t::getHash(), WalkTrackerStatus},
+      {pose_t::getHash(), WalkFixed<pose_t>},
+      {object_t::getHash(), WalkFixed<object_t>},
+      {hypothesis_t::getHash(), WalkFixed<hypothesis_t>},
+  };
+  return layouts;
+}
+
 }  // namespace
 
 bool CheckLengths(std::int64_t fingerprint, const void* data, std::size_t size, std::string* why) {
@@ -198,40 +221,17 @@ bool CheckLengths(std::int64_t fingerprint, const void* data, std::size_t size, 
     if (why) *why = "shorter than a fingerprint";
     return false;
   }
-  Walker w(static_cast<const unsigned char*>(data) + 8, size - 8, why);
-  bool ok = true;
-  if (fingerprint == ladar_scan_t::getHash()) {
-    ok = WalkLadarScan(w);
-  } else if (fingerprint == object_list_t::getHash()) {
-    ok = WalkObjectList(w);
-  } else if (fingerprint == detection_list_t::getHash()) {
-    ok = WalkDetectionList(w);
-  } else if (fingerprint == detection_t::getHash()) {
-    ok = w.Skip(FixedSize<detection_t>(), "detection_t");
-  } else if (fingerprint == track_t::getHash()) {
-    ok = WalkTrack(w);
-  } else if (fingerprint == track_list_t::getHash()) {
-    ok = WalkTrackList(w);
-  } else if (fingerprint == track_debug_entry_t::getHash()) {
-    ok = WalkDebugEntry(w);
-  } else if (fingerprint == track_debug_t::getHash()) {
-    ok = WalkTrackDebug(w);
-  } else if (fingerprint == tracker_status_t::getHash()) {
-    ok = WalkTrackerStatus(w);
-  } else if (fingerprint == pose_t::getHash()) {
-    ok = w.Skip(FixedSize<pose_t>(), "pose_t");
-  } else if (fingerprint == object_t::getHash()) {
-    ok = w.Skip(FixedSize<object_t>(), "object_t");
-  } else if (fingerprint == hypothesis_t::getHash()) {
-    ok = w.Skip(FixedSize<hypothesis_t>(), "hypothesis_t");
-  } else {
-    return true;  // not a vtrack type: the fingerprint check refuses it
+  for (const MessageLayout& layout : Layouts()) {
+    if (layout.fingerprint != fingerprint) continue;
+    Walker w(static_cast<const unsigned char*>(data) + 8, size - 8, why);
+    if (!layout.walk(w)) return false;
+    // A message is exactly its encoding: bytes left over mean the layout is not what we think.
+    if (w.remaining() != 0) {
+      return w.Fail("message", std::to_string(w.remaining()) + " trailing bytes");
+    }
+    return true;
   }
-  // A message is exactly its encoding: bytes left over mean the layout is not what we think.
-  if (ok && w.remaining() != 0) {
-    return w.Fail("message", std::to_string(w.remaining()) + " trailing bytes");
-  }
-  return ok;
+  return true;  // not a vtrack type: the fingerprint check refuses it
 }
 
 }  // namespace vtrack::lcm_util

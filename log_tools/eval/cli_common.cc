@@ -2,9 +2,9 @@
 
 #include <cstdio>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 
+#include "lcmtypes/util/text.h"
 #include "sensor_driver/kitti/kitti_io.h"
 
 namespace po = boost::program_options;
@@ -50,24 +50,15 @@ void AddEvalOptions(po::options_description* desc, EvalCliOptions* o) {
 }
 
 std::vector<double> ParseDoubleList(const std::string& option, const std::string& text) {
-  std::vector<double> out;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    std::size_t used = 0;
-    double v = 0.0;
-    try {
-      v = std::stod(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != item.size()) {
-      throw std::invalid_argument("--" + option + ": '" + item + "' is not a number (in '" + text + "')");
-    }
-    out.push_back(v);
+  std::string bad;
+  const std::optional<std::vector<double>> out =
+      lcm_util::ParseNumberList(text, ',', /*finite_only=*/false, &bad);
+  if (!out) {
+    throw std::invalid_argument("--" + option + ": '" + bad + "' is not a number (in '" + text +
+                                "')");
   }
-  if (out.empty()) throw std::invalid_argument("--" + option + ": empty list");
-  return out;
+  if (out->empty()) throw std::invalid_argument("--" + option + ": empty list");
+  return *out;
 }
 
 namespace {

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "lcmtypes/util/command_line.h"
 #include "log_tools/eval/compare.h"
 #include "sensor_driver/kitti/kitti_layout.h"
 
@@ -70,12 +71,9 @@ int main(int argc, char** argv) {
 
   try {
     po::variables_map vm;
-    po::store(po::parse_command_line(argc, argv, desc), vm);
-    if (vm.count("help")) {
-      std::cout << desc << "\n";
+    if (!vtrack::lcm_util::StoreCommandLine(po::parse_command_line(argc, argv, desc), desc, &vm)) {
       return 0;
     }
-    po::notify(vm);
     if (!o.eval.mode.empty()) throw std::invalid_argument("--mode is not an option here: use --modes");
     if (o.reuse && o.work_dir.empty()) throw std::invalid_argument("--reuse needs --work-dir");
     for (const auto& s : SplitList(scenarios)) o.items.push_back(ScenarioItem(s));

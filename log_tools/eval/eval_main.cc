@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "lcmtypes/util/command_line.h"
 #include "log_tools/eval/cli_common.h"
 #include "log_tools/eval/evaluator.h"
 #include "log_tools/eval/kitti_export.h"
@@ -45,12 +46,10 @@ int main(int argc, char** argv) {
 
   try {
     po::variables_map vm;
-    po::store(po::command_line_parser(argc, argv).options(all).positional(pos).run(), vm);
-    if (vm.count("help")) {
-      std::cout << desc << "\n";
+    if (!vtrack::lcm_util::StoreCommandLine(
+            po::command_line_parser(argc, argv).options(all).positional(pos).run(), desc, &vm)) {
       return 0;
     }
-    po::notify(vm);
     if (logs.empty()) throw std::invalid_argument("no LOG given (see --help)");
     if (!kitti_out.empty() && eval_opts.kitti_calib.empty()) {
       throw std::invalid_argument("--kitti-out needs --kitti-calib FILE");

@@ -133,6 +133,22 @@ std::optional<Eigen::Vector2d> TruthAt(const std::map<std::int64_t, vtrack::obje
   return Eigen::Vector2d((1 - s) * a->x + s * b->x, (1 - s) * a->y + s * b->y);
 }
 
+// True if an object or track of a frame can be scored: its position is finite and its id is new
+// in the frame (ids holds those seen). Otherwise counts "<kind>_not_finite" or
+// "<kind>_duplicate_id" in *problems and returns false.
+bool Admit(double x, double y, std::int64_t id, const std::string& kind,
+           std::set<std::int64_t>* ids, std::map<std::string, std::int64_t>* problems) {
+  if (!std::isfinite(x) || !std::isfinite(y)) {
+    ++(*problems)[kind + "_not_finite"];
+    return false;
+  }
+  if (!ids->insert(id).second) {
+    ++(*problems)[kind + "_duplicate_id"];
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 bool CameraRegion::Contains(const Eigen::Vector3d& p_sensor) const {
@@ -376,14 +392,7 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params) {
     std::vector<bool> truth_scored;
     std::set<std::int64_t> truth_ids;
     for (const auto& o : gt.objects) {
-      if (!std::isfinite(o.x) || !std::isfinite(o.y)) {
-        ++s.problems["truth_not_finite"];
-        continue;
-      }
-      if (!truth_ids.insert(o.id).second) {
-        ++s.problems["truth_duplicate_id"];
-        continue;
-      }
+      if (!Admit(o.x, o.y, o.id, "truth", &truth_ids, &s.problems)) continue;
       const bool is_scored =
           o.in_labelled_region && IsVehicleClass(o.object_class) &&
           in_region(o.x, o.y,
@@ -406,14 +415,7 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params) {
       const bool status_ok = tr.status == vtrack::track_t::STATUS_CONFIRMED ||
                              (params.score_coasting && tr.status == vtrack::track_t::STATUS_COASTING);
       if (!status_ok || tr.object_class != vtrack::track_t::CLASS_VEHICLE) continue;
-      if (!std::isfinite(tr.x) || !std::isfinite(tr.y)) {
-        ++s.problems["track_not_finite"];
-        continue;
-      }
-      if (!track_ids.insert(tr.id).second) {
-        ++s.problems["track_duplicate_id"];
-        continue;
-      }
+      if (!Admit(tr.x, tr.y, tr.id, "track", &track_ids, &s.problems)) continue;
       candidates.push_back(&tr);
       candidate_pose.push_back(Advance(tr, dt));
     }

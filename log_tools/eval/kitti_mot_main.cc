@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "lcmtypes/util/command_line.h"
 #include "log_tools/eval/json_writer.h"
 #include "log_tools/eval/kitti_mot.h"
 
@@ -174,12 +175,9 @@ int ParseOptions(int argc, char** argv, Options* o) {
     ("quiet,q", po::bool_switch(&o->quiet), "no progress output");
   try {
     po::variables_map vm;
-    po::store(po::parse_command_line(argc, argv, desc), vm);
-    if (vm.count("help")) {
-      std::cout << desc << "\n";
+    if (!vtrack::lcm_util::StoreCommandLine(po::parse_command_line(argc, argv, desc), desc, &vm)) {
       return 0;
     }
-    po::notify(vm);
     if (o->labels_dir.empty()) throw std::invalid_argument("--labels DIR is required (see --help)");
     if (o->results_dir.empty()) {
       throw std::invalid_argument("--results DIR is required (see --help)");

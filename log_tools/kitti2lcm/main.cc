@@ -7,6 +7,7 @@
 #include <iostream>
 #include <string>
 
+#include "lcmtypes/util/command_line.h"
 #include "lcmtypes/util/process.h"
 #include "log_tools/kitti2lcm/converter.h"
 #include "sensor_driver/kitti/kitti_sequence.h"
@@ -64,12 +65,9 @@ int main(int argc, char** argv) {
 
   po::variables_map vm;
   try {
-    po::store(po::parse_command_line(argc, argv, desc), vm);
-    if (vm.count("help")) {
-      std::cout << desc << "\n";
+    if (!vtrack::lcm_util::StoreCommandLine(po::parse_command_line(argc, argv, desc), desc, &vm)) {
       return 0;
     }
-    po::notify(vm);
   } catch (const po::error& e) {
     std::cerr << "vtrack-kitti2lcm: " << e.what() << "\n(see vtrack-kitti2lcm --help)\n";
     return 2;

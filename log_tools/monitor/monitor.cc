@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdarg>
 #include <cstdio>
 #include <limits>
 
 #include <Eigen/Geometry>
 
 #include "lcmtypes/util/decode.h"
+#include "lcmtypes/util/text.h"
 #include "base/angle.h"
 #include "base/pose.h"
 #include "vtrack/hypothesis_t.hpp"
@@ -27,15 +27,7 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-std::string Format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
-std::string Format(const char* fmt, ...) {
-  char buf[512];
-  va_list ap;
-  va_start(ap, fmt);
-  std::vsnprintf(buf, sizeof(buf), fmt, ap);
-  va_end(ap);
-  return buf;
-}
+using lcm_util::Format;
 
 long long LL(std::int64_t v) { return static_cast<long long>(v); }
 

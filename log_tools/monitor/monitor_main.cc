@@ -16,6 +16,7 @@
 #include <regex>
 #include <string>
 
+#include "lcmtypes/util/command_line.h"
 #include "lcmtypes/util/log_reader.h"
 #include "lcmtypes/util/process.h"
 #include "log_tools/monitor/monitor.h"
@@ -168,12 +169,9 @@ int main(int argc, char** argv) {
      "cut lines to this many characters (-1 = the terminal's width, 0 = no limit)");
   try {
     po::variables_map vm;
-    po::store(po::parse_command_line(argc, argv, desc), vm);
-    if (vm.count("help")) {
-      std::cout << desc << "\n";
+    if (!vtrack::lcm_util::StoreCommandLine(po::parse_command_line(argc, argv, desc), desc, &vm)) {
       return 0;
     }
-    po::notify(vm);
     if (!(duration_s >= 0.0) || !std::isfinite(duration_s)) {
       throw std::invalid_argument("--duration must be >= 0, got " + std::to_string(duration_s));
     }

@@ -19,67 +19,66 @@ kitti::SequenceOptions KittiCliOptions(const boost::program_options::variables_m
   return o;
 }
 
-KittiScanTimeline::KittiScanTimeline(kitti::SequenceOptions options, lcm::LCM* lcm,
-                                     std::string scan_channel, std::string truth_channel)
+KittiTimeline::KittiTimeline(kitti::SequenceOptions options, lcm::LCM* lcm)
     : seq_(std::make_unique<kitti::Sequence>(std::move(options))),
       lcm_(lcm),
-      scan_channel_(std::move(scan_channel)),
-      truth_channel_(std::move(truth_channel)),
       base_(seq_->ScanUtime(0)) {}
 
-std::int64_t KittiScanTimeline::LapUs() const { return seq_->num_frames() * kFrameUs; }
+std::int64_t KittiTimeline::LapUs() const { return seq_->num_frames() * kFrameUs; }
+
+KittiScanTimeline::KittiScanTimeline(kitti::SequenceOptions options, lcm::LCM* lcm,
+                                     std::string scan_channel, std::string truth_channel)
+    : KittiTimeline(std::move(options), lcm),
+      scan_channel_(std::move(scan_channel)),
+      truth_channel_(std::move(truth_channel)) {}
 
 std::int64_t KittiScanTimeline::PublishOffsetUs(int i) const {
-  return seq_->ScanUtime(i) - base_ + seq_->options().velodyne.sweep_duration_us;
+  return seq().ScanUtime(i) - base() + seq().options().velodyne.sweep_duration_us;
 }
 
 void KittiScanTimeline::Prepare(int i, std::int64_t lap_start_utime, std::int64_t lap) {
-  const std::int64_t shift = lap_start_utime - base_;
-  const kitti::VelodyneFrame frame = seq_->ReadFrame(i);
-  scan_ = seq_->Scan(i, frame);
+  const std::int64_t shift = lap_start_utime - base();
+  const kitti::VelodyneFrame frame = seq().ReadFrame(i);
+  scan_ = seq().Scan(i, frame);
   scan_.utime += shift;
-  scan_.seq = lap * seq_->num_frames() + i;
-  have_truth_ = !truth_channel_.empty() && seq_->has_labels();
+  scan_.seq = lap * seq().num_frames() + i;
+  have_truth_ = !truth_channel_.empty() && seq().has_labels();
   if (have_truth_) {
-    truth_ = seq_->GroundTruth(i, frame);
+    truth_ = seq().GroundTruth(i, frame);
     truth_.utime += shift;
     truth_.scan_seq = scan_.seq;
   }
 }
 
 void KittiScanTimeline::Publish() {
-  if (lcm_->publish(scan_channel_, &scan_) < 0) log_.Warn("publish", "publishing " + scan_channel_ + " failed");
-  if (have_truth_ && lcm_->publish(truth_channel_, &truth_) < 0) {
+  if (lcm()->publish(scan_channel_, &scan_) < 0) {
+    log_.Warn("publish", "publishing " + scan_channel_ + " failed");
+  }
+  if (have_truth_ && lcm()->publish(truth_channel_, &truth_) < 0) {
     log_.Warn("publish_truth", "publishing " + truth_channel_ + " failed");
   }
 }
 
 KittiPoseTimeline::KittiPoseTimeline(kitti::SequenceOptions options, double rate_hz,
                                      lcm::LCM* lcm, std::string channel)
-    : seq_(std::make_unique<kitti::Sequence>(std::move(options))),
-      rate_hz_(rate_hz),
-      lcm_(lcm),
-      channel_(std::move(channel)),
-      base_(seq_->ScanUtime(0)) {
+    : KittiTimeline(std::move(options), lcm), rate_hz_(rate_hz), channel_(std::move(channel)) {
   if (!(rate_hz_ >= 1.0 && rate_hz_ <= 1000.0)) {
     throw std::invalid_argument("--pose-rate = " + std::to_string(rate_hz_) + " Hz: must be in [1, 1000]");
   }
   while (PublishOffsetUs(count_) < LapUs()) ++count_;
 }
 
-std::int64_t KittiPoseTimeline::LapUs() const { return seq_->num_frames() * kFrameUs; }
-
 std::int64_t KittiPoseTimeline::PublishOffsetUs(int k) const {
   return std::llround(k * 1e6 / rate_hz_);
 }
 
 void KittiPoseTimeline::Prepare(int k, std::int64_t lap_start_utime, std::int64_t) {
-  pose_ = seq_->PoseAt(base_ + PublishOffsetUs(k));
+  pose_ = seq().PoseAt(base() + PublishOffsetUs(k));
   pose_.utime = lap_start_utime + PublishOffsetUs(k);
 }
 
 void KittiPoseTimeline::Publish() {
-  if (lcm_->publish(channel_, &pose_) < 0) log_.Warn("publish", "publishing " + channel_ + " failed");
+  if (lcm()->publish(channel_, &pose_) < 0) log_.Warn("publish", "publishing " + channel_ + " failed");
 }
 
 }  // namespace vtrack::sim

@@ -22,29 +22,43 @@ namespace vtrack::sim {
 // --kitti, --sequence, --poses, --oxts, --cache-dir as SequenceOptions.
 kitti::SequenceOptions KittiCliOptions(const boost::program_options::variables_map& vm);
 
-class KittiScanTimeline : public Timeline {
+// What both KITTI timelines hold: the sequence, the bus, and lap time 0.
+class KittiTimeline : public Timeline {
  public:
+  std::int64_t LapUs() const override;  // num_frames * 100 ms
+
+ protected:
   // Throws kitti::KittiError for a missing or malformed sequence.
-  KittiScanTimeline(kitti::SequenceOptions options, lcm::LCM* lcm, std::string scan_channel,
-                    std::string truth_channel /* "" = no ground truth */);
-  int Count() const override { return seq_->num_frames(); }
-  std::int64_t PublishOffsetUs(int i) const override;
-  void Prepare(int i, std::int64_t lap_start_utime, std::int64_t lap) override;
-  void Publish() override;
-  std::int64_t LapUs() const;
+  KittiTimeline(kitti::SequenceOptions options, lcm::LCM* lcm);
+  const kitti::Sequence& seq() const { return *seq_; }
+  lcm::LCM* lcm() const { return lcm_; }
+  std::int64_t base() const { return base_; }
 
  private:
   std::unique_ptr<kitti::Sequence> seq_;
   lcm::LCM* lcm_;
-  std::string scan_channel_, truth_channel_;
   std::int64_t base_;  // ScanUtime(0): lap time 0
+};
+
+class KittiScanTimeline : public KittiTimeline {
+ public:
+  // Throws kitti::KittiError for a missing or malformed sequence.
+  KittiScanTimeline(kitti::SequenceOptions options, lcm::LCM* lcm, std::string scan_channel,
+                    std::string truth_channel /* "" = no ground truth */);
+  int Count() const override { return seq().num_frames(); }
+  std::int64_t PublishOffsetUs(int i) const override;
+  void Prepare(int i, std::int64_t lap_start_utime, std::int64_t lap) override;
+  void Publish() override;
+
+ private:
+  std::string scan_channel_, truth_channel_;
   vtrack::ladar_scan_t scan_;
   vtrack::object_list_t truth_;
   bool have_truth_ = false;
   lcm_util::RateLimitedLog log_{"vtrack-ladar-driver"};
 };
 
-class KittiPoseTimeline : public Timeline {
+class KittiPoseTimeline : public KittiTimeline {
  public:
   KittiPoseTimeline(kitti::SequenceOptions options, double rate_hz, lcm::LCM* lcm,
                     std::string channel);
@@ -52,14 +66,10 @@ class KittiPoseTimeline : public Timeline {
   std::int64_t PublishOffsetUs(int k) const override;
   void Prepare(int k, std::int64_t lap_start_utime, std::int64_t lap) override;
   void Publish() override;
-  std::int64_t LapUs() const;
 
  private:
-  std::unique_ptr<kitti::Sequence> seq_;
   double rate_hz_;
-  lcm::LCM* lcm_;
   std::string channel_;
-  std::int64_t base_;
   int count_ = 0;
   vtrack::pose_t pose_;
   lcm_util::RateLimitedLog log_{"vtrack-ego-pose"};

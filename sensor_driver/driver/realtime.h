@@ -33,6 +33,7 @@ class Timeline {
  public:
   virtual ~Timeline() = default;
   virtual int Count() const = 0;
+  virtual std::int64_t LapUs() const = 0;  // [us] duration of one lap (RealtimeOptions::lap_us)
   virtual std::int64_t PublishOffsetUs(int i) const = 0;  // after the lap's start; non-decreasing
   // Builds item i of lap `lap` (which starts at lap_start_utime). Called before its time.
   virtual void Prepare(int i, std::int64_t lap_start_utime, std::int64_t lap) = 0;

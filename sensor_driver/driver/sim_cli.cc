@@ -1,6 +1,8 @@
 #include "sensor_driver/driver/sim_cli.h"
 
-#include <iostream>
+#include <cstdio>
+
+#include "lcmtypes/util/command_line.h"
 
 namespace vtrack::sim {
 
@@ -81,13 +83,23 @@ std::unique_ptr<Simulator> MakeSimulator(const SimCli& cli) {
 
 bool ParseCommandLine(int argc, char** argv, const po::options_description& desc,
                       const std::string& usage, po::variables_map* vm) {
-  po::store(po::command_line_parser(argc, argv).options(desc).run(), *vm);
-  if (vm->count("help")) {
-    std::cout << usage << "\n\n" << desc << "\n";
-    return false;
+  return lcm_util::StoreCommandLine(po::command_line_parser(argc, argv).options(desc).run(), desc,
+                                   vm, usage);
+}
+
+std::optional<int> ParseSimCommandLine(int argc, char** argv, const po::options_description& desc,
+                                       const std::string& usage, const char* name,
+                                       const std::function<void(const po::variables_map&)>& check,
+                                       po::variables_map* vm, SimCli* cli) {
+  try {
+    if (!ParseCommandLine(argc, argv, desc, usage, vm)) return 0;
+    *cli = ReadSimCli(*vm);
+    if (check) check(*vm);
+  } catch (const po::error& e) {
+    std::fprintf(stderr, "%s: %s (see --help)\n", name, e.what());
+    return 2;
   }
-  po::notify(*vm);
-  return true;
+  return std::nullopt;
 }
 
 }  // namespace vtrack::sim

@@ -5,6 +5,7 @@
 #include <boost/program_options.hpp>
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -46,5 +47,15 @@ std::unique_ptr<Simulator> MakeSimulator(const SimCli& cli);
 // Throws boost::program_options::error on bad options.
 bool ParseCommandLine(int argc, char** argv, const boost::program_options::options_description& desc,
                       const std::string& usage, boost::program_options::variables_map* vm);
+
+// Parses argv (ParseCommandLine) into *vm and *cli (ReadSimCli), then calls check (if set),
+// which throws boost::program_options::error for options that do not go together. Returns the
+// exit status if the process should stop here: 0 after the help for --help, 2 after printing
+// "name: MESSAGE (see --help)" for a bad command line; nullopt to go on.
+std::optional<int> ParseSimCommandLine(
+    int argc, char** argv, const boost::program_options::options_description& desc,
+    const std::string& usage, const char* name,
+    const std::function<void(const boost::program_options::variables_map&)>& check,
+    boost::program_options::variables_map* vm, SimCli* cli);
 
 }  // namespace vtrack::sim

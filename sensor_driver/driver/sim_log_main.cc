@@ -34,16 +34,15 @@ int main(int argc, char** argv) {
       "log file as fast as possible, with the contents a live run of vtrack-ladar-driver and\n"
       "vtrack-ego-pose (same --start-utime and seed) recorded by lcm-logger would have.\n\n"
       "usage: vtrack-sim-log --scenario NAME --out run.lcm [--seed N] [--sensor S] [...]";
-  po::variables_map vm;
-  vtrack::sim::SimCli cli;
-  try {
-    if (!vtrack::sim::ParseCommandLine(argc, argv, desc, usage, &vm)) return 0;
-    cli = vtrack::sim::ReadSimCli(vm);
+  auto check = [](const po::variables_map& vm) {
     if (!vm.count("scenario")) throw po::error("--scenario is required");
     if (!vm.count("out") && !vm.count("describe")) throw po::error("--out is required");
-  } catch (const po::error& e) {
-    std::fprintf(stderr, "vtrack-sim-log: %s (see --help)\n", e.what());
-    return 2;
+  };
+  po::variables_map vm;
+  vtrack::sim::SimCli cli;
+  if (const auto status = vtrack::sim::ParseSimCommandLine(argc, argv, desc, usage,
+                                                           "vtrack-sim-log", check, &vm, &cli)) {
+    return *status;
   }
   const bool quiet = vm.count("quiet") > 0;
   try {

@@ -18,6 +18,7 @@ class SimScanTimeline : public Timeline {
   SimScanTimeline(Simulator* sim, lcm::LCM* lcm, std::string scan_channel,
                   std::string truth_channel /* "" = do not publish ground truth */);
   int Count() const override { return sim_->NumScans(); }
+  std::int64_t LapUs() const override { return sim_->RunDurationUs(); }
   std::int64_t PublishOffsetUs(int i) const override { return sim_->ScanPublishOffsetUs(i); }
   void Prepare(int i, std::int64_t lap_start_utime, std::int64_t lap) override;
   void Publish() override;
@@ -38,6 +39,7 @@ class SimPoseTimeline : public Timeline {
  public:
   SimPoseTimeline(Simulator* sim, lcm::LCM* lcm, std::string channel);
   int Count() const override { return sim_->NumPoses(); }
+  std::int64_t LapUs() const override { return sim_->RunDurationUs(); }
   std::int64_t PublishOffsetUs(int k) const override { return sim_->PoseOffsetUs(k); }
   void Prepare(int k, std::int64_t lap_start_utime, std::int64_t lap) override;
   void Publish() override;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <sstream>
 #include <string_view>
@@ -94,6 +95,72 @@ Eigen::Matrix3d Orthonormalised(const Eigen::Matrix3d& r) {
   return Eigen::Quaterniond(r).normalized().toRotationMatrix();
 }
 
+// max |R^T R - I|: how far r is from orthonormal.
+double OrthonormalityError(const Eigen::Matrix3d& r) {
+  return (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+}
+
+using Fields = std::vector<std::string_view>;
+
+// Calls fn(line, fields) for each line of the text file at path that is not blank: line counts
+// from 1, fields are separated by white space (and by commas if commas_separate). what names the
+// kind of file in the error if it cannot be opened.
+void ForEachRecord(const std::string& path, const char* what, bool commas_separate,
+                   const std::function<void(int, const Fields&)>& fn) {
+  std::ifstream in = OpenText(path, what);
+  std::string text;
+  int line = 0;
+  while (std::getline(in, text)) {
+    ++line;
+    if (IsBlank(text)) continue;
+    if (commas_separate) std::replace(text.begin(), text.end(), ',', ' ');
+    fn(line, Split(text));
+  }
+}
+
+// ForEachRecord, collecting what parse makes of each line.
+template <class T>
+std::vector<T> ReadRecords(const std::string& path, const char* what, bool commas_separate,
+                           const std::function<T(int, const Fields&)>& parse) {
+  std::vector<T> out;
+  ForEachRecord(path, what, commas_separate,
+                [&](int line, const Fields& tok) { out.push_back(parse(line, tok)); });
+  return out;
+}
+
+// Refuses a line without exactly n fields: "expected n <what>, got m".
+void CheckFieldCount(const Fields& tok, std::size_t n, const char* what, const std::string& path,
+                     int line) {
+  if (tok.size() != n) {
+    Fail(path, line, "expected " + std::to_string(n) + " " + what + ", got " +
+                         std::to_string(tok.size()));
+  }
+}
+
+// The box of a Label or DetectionRow, from field `first` on: h w l, the bottom centre x y z
+// (rect frame) and the rotation about y (named rotation_field in errors).
+template <class Row>
+void ParseBox(const Fields& tok, std::size_t first, const char* rotation_field,
+              const std::string& path, int line, Row* row) {
+  row->height = ParseDouble(tok[first], path, line, "h");
+  row->width = ParseDouble(tok[first + 1], path, line, "w");
+  row->length = ParseDouble(tok[first + 2], path, line, "l");
+  for (std::size_t k = 0; k < 3; ++k) {
+    row->bottom_center_rect[static_cast<Eigen::Index>(k)] =
+        ParseDouble(tok[first + 3 + k], path, line, "location");
+  }
+  row->rotation_y = ParseDouble(tok[first + 6], path, line, rotation_field);
+}
+
+void CheckDimensions(double height, double width, double length, const std::string& path,
+                     int line) {
+  if (!(height > 0.0 && width > 0.0 && length > 0.0)) {
+    std::ostringstream os;
+    os << "non-positive dimensions h w l = " << height << " " << width << " " << length;
+    Fail(path, line, os.str());
+  }
+}
+
 }  // namespace
 
 VelodyneFrame ReadVelodyneBin(const std::string& path) {
@@ -137,7 +204,6 @@ Eigen::Affine3d Calibration::RectFromVelo() const {
 Eigen::Affine3d Calibration::VeloFromRect() const { return RectFromVelo().inverse(Eigen::Affine); }
 
 Calibration ReadCalibration(const std::string& path) {
-  std::ifstream in = OpenText(path, "calibration");
   // Canonical key -> (number of values, line found, values).
   struct Entry {
     int line = 0;
@@ -152,16 +218,11 @@ Calibration ReadCalibration(const std::string& path) {
   const std::map<std::string, std::size_t> sizes = {
       {"P0", 12}, {"P1", 12}, {"P2", 12}, {"P3", 12},
       {"R0_rect", 9}, {"Tr_velo_to_cam", 12}, {"Tr_imu_to_velo", 12}};
-  std::string text;
-  int line = 0;
-  while (std::getline(in, text)) {
-    ++line;
-    if (IsBlank(text)) continue;
-    const auto tok = Split(text);
+  auto read_entry = [&](int line, const Fields& tok) {
     std::string key(tok[0]);
     if (!key.empty() && key.back() == ':') key.pop_back();
     const auto alias = aliases.find(key);
-    if (alias == aliases.end()) continue;  // other calibration entries (e.g. Tr_cam_to_road) are not needed
+    if (alias == aliases.end()) return;  // other calibration entries (e.g. Tr_cam_to_road) are not needed
     const std::string& canon = alias->second;
     const std::size_t want = sizes.at(canon);
     if (tok.size() - 1 != want) {
@@ -175,7 +236,8 @@ Calibration ReadCalibration(const std::string& path) {
       e.values.push_back(ParseDouble(tok[k], path, line, key.c_str()));
     }
     entries[canon] = std::move(e);
-  }
+  };
+  ForEachRecord(path, "calibration", /*commas_separate=*/false, read_entry);
   for (const char* required : {"P2", "R0_rect", "Tr_velo_to_cam"}) {
     if (!entries.count(required)) {
       Fail(path, 0, std::string("missing calibration entry ") + required);
@@ -192,8 +254,7 @@ Calibration ReadCalibration(const std::string& path) {
     const Entry& e = entries.at(key);
     const Eigen::Matrix<double, 3, 4> m = mat34(e.values);
     const Eigen::Matrix3d r = m.leftCols<3>();
-    if ((r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-3 ||
-        r.determinant() < 0.0) {
+    if (OrthonormalityError(r) > 1e-3 || r.determinant() < 0.0) {
       std::ostringstream os;
       os << key << " is not a rigid transform: its 3x3 block is not a rotation (det "
          << r.determinant() << ")";
@@ -212,8 +273,7 @@ Calibration ReadCalibration(const std::string& path) {
   for (int r = 0; r < 3; ++r) {
     for (int col = 0; col < 3; ++col) c.R0_rect(r, col) = r0.values[static_cast<std::size_t>(3 * r + col)];
   }
-  if ((c.R0_rect.transpose() * c.R0_rect - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-3 ||
-      c.R0_rect.determinant() < 0.0) {
+  if (OrthonormalityError(c.R0_rect) > 1e-3 || c.R0_rect.determinant() < 0.0) {
     Fail(path, r0.line, "R0_rect is not a rotation");
   }
   c.cam_from_velo = rigid("Tr_velo_to_cam");
@@ -234,14 +294,7 @@ std::int8_t ClassOfType(const std::string& type) {
 }
 
 std::vector<Label> ReadLabels(const std::string& path) {
-  std::ifstream in = OpenText(path, "label");
-  std::vector<Label> labels;
-  std::string text;
-  int line = 0;
-  while (std::getline(in, text)) {
-    ++line;
-    if (IsBlank(text)) continue;
-    const auto tok = Split(text);
+  auto parse = [&](int line, const Fields& tok) {
     if (tok.size() != 17 && tok.size() != 18) {
       Fail(path, line, "expected 17 fields (frame track_id type truncated occluded alpha x1 y1 x2 y2 "
                        "h w l x y z rotation_y) or 18 (with score), got " + std::to_string(tok.size()));
@@ -260,84 +313,45 @@ std::vector<Label> ReadLabels(const std::string& path) {
     l.occluded = ParseIntegral(tok[4], path, line, "occluded");
     l.alpha = ParseDouble(tok[5], path, line, "alpha");
     for (int k = 0; k < 4; ++k) l.bbox[k] = ParseDouble(tok[6 + static_cast<std::size_t>(k)], path, line, "bbox");
-    l.height = ParseDouble(tok[10], path, line, "h");
-    l.width = ParseDouble(tok[11], path, line, "w");
-    l.length = ParseDouble(tok[12], path, line, "l");
-    for (int k = 0; k < 3; ++k) {
-      l.bottom_center_rect[k] = ParseDouble(tok[13 + static_cast<std::size_t>(k)], path, line, "location");
-    }
-    l.rotation_y = ParseDouble(tok[16], path, line, "rotation_y");
+    ParseBox(tok, 10, "rotation_y", path, line, &l);
     if (l.frame < 0) Fail(path, line, "negative frame " + std::to_string(l.frame));
     if (l.IsDontCare()) {
       if (l.track_id != -1) Fail(path, line, "DontCare with track_id " + std::to_string(l.track_id) + " (expected -1)");
     } else {
       if (l.track_id < 0) Fail(path, line, "negative track_id " + std::to_string(l.track_id) + " for " + l.type);
-      if (!(l.height > 0.0 && l.width > 0.0 && l.length > 0.0)) {
-        std::ostringstream os;
-        os << "non-positive dimensions h w l = " << l.height << " " << l.width << " " << l.length;
-        Fail(path, line, os.str());
-      }
+      CheckDimensions(l.height, l.width, l.length, path, line);
     }
-    labels.push_back(std::move(l));
-  }
-  return labels;
+    return l;
+  };
+  return ReadRecords<Label>(path, "label", /*commas_separate=*/false, parse);
 }
 
 std::vector<DetectionRow> ReadDetections(const std::string& path) {
-  std::ifstream in = OpenText(path, "detections");
-  std::vector<DetectionRow> rows;
-  std::string text;
-  int line = 0;
-  while (std::getline(in, text)) {
-    ++line;
-    if (IsBlank(text)) continue;
-    std::replace(text.begin(), text.end(), ',', ' ');
-    const auto tok = Split(text);
-    if (tok.size() != 15) {
-      Fail(path, line, "expected 15 comma-separated fields (frame,type,x1,y1,x2,y2,score,h,w,l,x,y,z,"
-                       "rot_y,alpha), got " + std::to_string(tok.size()));
-    }
+  auto parse = [&](int line, const Fields& tok) {
+    CheckFieldCount(tok, 15, "comma-separated fields (frame,type,x1,y1,x2,y2,score,h,w,l,x,y,z,"
+                             "rot_y,alpha)", path, line);
     DetectionRow d;
     d.line = line;
     d.frame = ParseInt(tok[0], path, line, "frame");
     d.type = ParseInt(tok[1], path, line, "type");
     d.score = ParseDouble(tok[6], path, line, "score");
-    d.height = ParseDouble(tok[7], path, line, "h");
-    d.width = ParseDouble(tok[8], path, line, "w");
-    d.length = ParseDouble(tok[9], path, line, "l");
-    for (int k = 0; k < 3; ++k) {
-      d.bottom_center_rect[k] = ParseDouble(tok[10 + static_cast<std::size_t>(k)], path, line, "location");
-    }
-    d.rotation_y = ParseDouble(tok[13], path, line, "rot_y");
+    ParseBox(tok, 7, "rot_y", path, line, &d);
     if (d.frame < 0) Fail(path, line, "negative frame " + std::to_string(d.frame));
-    if (!(d.height > 0.0 && d.width > 0.0 && d.length > 0.0)) {
-      std::ostringstream os;
-      os << "non-positive dimensions h w l = " << d.height << " " << d.width << " " << d.length;
-      Fail(path, line, os.str());
-    }
-    rows.push_back(d);
-  }
-  return rows;
+    CheckDimensions(d.height, d.width, d.length, path, line);
+    return d;
+  };
+  return ReadRecords<DetectionRow>(path, "detections", /*commas_separate=*/true, parse);
 }
 
 std::vector<Eigen::Isometry3d> ReadPoses(const std::string& path) {
-  std::ifstream in = OpenText(path, "poses");
-  std::vector<Eigen::Isometry3d> poses;
-  std::string text;
-  int line = 0;
-  while (std::getline(in, text)) {
-    ++line;
-    if (IsBlank(text)) continue;
-    const auto tok = Split(text);
-    if (tok.size() != 12) {
-      Fail(path, line, "expected 12 values (row-major 3x4 [R|t]), got " + std::to_string(tok.size()));
-    }
+  auto parse = [&](int line, const Fields& tok) {
+    CheckFieldCount(tok, 12, "values (row-major 3x4 [R|t])", path, line);
     Eigen::Matrix<double, 3, 4> m;
     for (int r = 0; r < 3; ++r) {
       for (int c = 0; c < 4; ++c) m(r, c) = ParseDouble(tok[static_cast<std::size_t>(4 * r + c)], path, line, "pose");
     }
     const Eigen::Matrix3d r = m.leftCols<3>();
-    const double err = (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+    const double err = OrthonormalityError(r);
     if (err > 1e-3 || r.determinant() < 0.0) {
       std::ostringstream os;
       os << "rotation block is not a rotation (max |R^T R - I| = " << err << ", det "
@@ -347,26 +361,19 @@ std::vector<Eigen::Isometry3d> ReadPoses(const std::string& path) {
     Eigen::Isometry3d p = Eigen::Isometry3d::Identity();
     p.linear() = Orthonormalised(r);
     p.translation() = m.col(3);
-    poses.push_back(p);
-  }
+    return p;
+  };
+  std::vector<Eigen::Isometry3d> poses =
+      ReadRecords<Eigen::Isometry3d>(path, "poses", /*commas_separate=*/false, parse);
   if (poses.empty()) Fail(path, 0, "no poses in the file");
   return poses;
 }
 
 std::vector<OxtsRecord> ReadOxts(const std::string& path) {
-  std::ifstream in = OpenText(path, "OXTS");
-  std::vector<OxtsRecord> out;
-  std::string text;
-  int line = 0;
-  while (std::getline(in, text)) {
-    ++line;
-    if (IsBlank(text)) continue;
-    const auto tok = Split(text);
-    if (tok.size() != 30) {
-      Fail(path, line, "expected 30 OXTS values (lat lon alt roll pitch yaw vn ve vf vl vu ax ay az af al "
-                       "au wx wy wz wf wl wu pos_accuracy vel_accuracy navstat numsats posmode velmode "
-                       "orimode), got " + std::to_string(tok.size()));
-    }
+  auto parse = [&](int line, const Fields& tok) {
+    CheckFieldCount(tok, 30, "OXTS values (lat lon alt roll pitch yaw vn ve vf vl vu ax ay az af al "
+                             "au wx wy wz wf wl wu pos_accuracy vel_accuracy navstat numsats posmode "
+                             "velmode orimode)", path, line);
     static const char* kNames[25] = {"lat", "lon", "alt", "roll", "pitch", "yaw", "vn", "ve", "vf",
                                      "vl", "vu", "ax", "ay", "az", "af", "al", "au", "wx", "wy",
                                      "wz", "wf", "wl", "wu", "pos_accuracy", "vel_accuracy"};
@@ -390,8 +397,10 @@ std::vector<OxtsRecord> ReadOxts(const std::string& path) {
     if (std::abs(r.lon) > 180.0) {
       Fail(path, line, "longitude " + std::string(tok[1]) + " deg is outside [-180, 180]");
     }
-    out.push_back(r);
-  }
+    return r;
+  };
+  std::vector<OxtsRecord> out =
+      ReadRecords<OxtsRecord>(path, "OXTS", /*commas_separate=*/false, parse);
   if (out.empty()) Fail(path, 0, "no OXTS records in the file");
   return out;
 }

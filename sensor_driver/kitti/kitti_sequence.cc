@@ -69,6 +69,26 @@ double Slope(const std::vector<double>& t, const std::vector<double>& y) {
   return num / den;
 }
 
+// The length axis of a KITTI box in the rect frame (y down): R_y(rotation_y) * x
+// = (cos ry, 0, -sin ry).
+Eigen::Vector3d LengthAxisRect(double rotation_y) {
+  return Eigen::Vector3d(std::cos(rotation_y), 0.0, -std::sin(rotation_y));
+}
+
+// Sets the box of an object_t or detection_t: x and y of xy, z, the heading of axis (the length
+// axis) in the x-y plane, and the size of row (a Label or DetectionRow).
+template <class Box, class Row>
+void SetBox(const Eigen::Vector3d& xy, double z, const Eigen::Vector3d& axis, const Row& row,
+            Box* o) {
+  o->x = xy.x();
+  o->y = xy.y();
+  o->z = z;
+  o->yaw = WrapToPi(std::atan2(axis.y(), axis.x()));
+  o->length = row.length;
+  o->width = row.width;
+  o->height = row.height;
+}
+
 }  // namespace
 
 std::string SequenceOptions::Validate() const {
@@ -288,10 +308,10 @@ void Sequence::BuildGroundTruth() {
     if (l.IsDontCare()) continue;
     const Eigen::Isometry3d& world_from_velo = world_from_body_[static_cast<std::size_t>(l.frame)];
     // The label's box in the rect frame (y down): bottom centre, centre h/2 above it, and the
-    // length axis R_y(rotation_y) * x = (cos ry, 0, -sin ry).
+    // length axis.
     const Eigen::Vector3d bottom_rect = l.bottom_center_rect;
     const Eigen::Vector3d centre_rect = bottom_rect - Eigen::Vector3d(0.0, 0.5 * l.height, 0.0);
-    const Eigen::Vector3d axis_rect(std::cos(l.rotation_y), 0.0, -std::sin(l.rotation_y));
+    const Eigen::Vector3d axis_rect = LengthAxisRect(l.rotation_y);
     const Eigen::Vector3d centre_world = world_from_velo * (velo_from_rect * centre_rect);
     const Eigen::Vector3d bottom_world = world_from_velo * (velo_from_rect * bottom_rect);
     const Eigen::Vector3d axis_world = world_from_velo.linear() * (velo_from_rect.linear() * axis_rect);
@@ -299,13 +319,7 @@ void Sequence::BuildGroundTruth() {
     vtrack::object_t o;
     o.id = l.track_id;
     o.object_class = ClassOfType(l.type);
-    o.x = centre_world.x();
-    o.y = centre_world.y();
-    o.z = bottom_world.z();
-    o.yaw = WrapToPi(std::atan2(axis_world.y(), axis_world.x()));
-    o.length = l.length;
-    o.width = l.width;
-    o.height = l.height;
+    SetBox(centre_world, bottom_world.z(), axis_world, l, &o);
     const double nan = std::numeric_limits<double>::quiet_NaN();
     o.vx = o.vy = o.speed = o.yaw_rate = nan;  // filled below where the track has other frames
     o.rear_axle_offset = nan;                  // unknown for real data
@@ -374,23 +388,15 @@ vtrack::detection_list_t Sequence::Detections(int i) const {
   list.source = "pointrcnn";
   const Eigen::Affine3d velo_from_rect = calib_.VeloFromRect();
   for (const DetectionRow& d : detections_[static_cast<std::size_t>(i)]) {
-    // As the labels: the length axis R_y(rot_y) * x = (cos ry, 0, -sin ry) in rect.
     const Eigen::Vector3d bottom = velo_from_rect * d.bottom_center_rect;
-    const Eigen::Vector3d axis =
-        velo_from_rect.linear() * Eigen::Vector3d(std::cos(d.rotation_y), 0.0, -std::sin(d.rotation_y));
+    const Eigen::Vector3d axis = velo_from_rect.linear() * LengthAxisRect(d.rotation_y);
     vtrack::detection_t o;
     o.object_class = d.type == 2 ? vtrack::object_t::CLASS_CAR
                      : d.type == 1 ? vtrack::object_t::CLASS_PEDESTRIAN
                      : d.type == 3 ? vtrack::object_t::CLASS_CYCLIST
                                    : vtrack::object_t::CLASS_UNKNOWN;
     o.score = static_cast<float>(d.score);
-    o.x = bottom.x();
-    o.y = bottom.y();
-    o.z = bottom.z();
-    o.yaw = WrapToPi(std::atan2(axis.y(), axis.x()));
-    o.length = d.length;
-    o.width = d.width;
-    o.height = d.height;
+    SetBox(bottom, bottom.z(), axis, d, &o);
     list.detections.push_back(o);
   }
   list.num_detections = static_cast<std::int32_t>(list.detections.size());

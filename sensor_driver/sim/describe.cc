@@ -1,7 +1,6 @@
 #include "sensor_driver/sim/describe.h"
 
 #include <algorithm>
-#include <cstdarg>
 #include <cstdio>
 #include <map>
 #include <set>
@@ -9,19 +8,12 @@
 #include <Eigen/Geometry>
 
 #include "base/angle.h"
+#include "lcmtypes/util/text.h"
 
 namespace vtrack::sim {
 namespace {
 
-std::string Line(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
-std::string Line(const char* fmt, ...) {
-  char buf[512];
-  va_list ap;
-  va_start(ap, fmt);
-  std::vsnprintf(buf, sizeof(buf), fmt, ap);
-  va_end(ap);
-  return buf;
-}
+using lcm_util::Format;
 
 struct PathSummary {
   MotionState start, end;
@@ -85,7 +77,7 @@ std::vector<Overlap> FindOverlaps(const Scenario& sc, double step, double tolera
   auto name = [&](int i) {
     if (i < 0) return std::string("ego");
     const SceneObject& o = scene.objects[i];
-    return Line("%s %lld", ObjectClassName(o.object_class), static_cast<long long>(o.id));
+    return Format("%s %lld", ObjectClassName(o.object_class), static_cast<long long>(o.id));
   };
   std::vector<Footprint> all(scene.objects.size());
   std::vector<int> movers;
@@ -122,16 +114,17 @@ void Describe(const Simulator& sim, std::ostream& out) {
   const LadarParams& p = sim.sensor();
   out << "scenario " << sc.name << " (" << sc.path << ")\n";
   if (!sc.description.empty()) out << "  " << sc.description << "\n";
-  out << Line("  duration %.2f s, seed %llu, start_utime %lld\n", sc.duration,
-              static_cast<unsigned long long>(sim.seed()), static_cast<long long>(sc.start_utime));
-  out << Line("  sensor %s: %d layers x %d columns, %.1f Hz, fov %.0f deg, max range %.0f m, "
-              "noise %.3f m, dropout %.3f, spurious %.3f; mounted at (%.2f, %.2f, %.2f)\n",
-              p.name.c_str(), p.NumLayers(), p.NumColumns(), p.rate_hz, p.fov_deg, p.max_range,
-              p.range_noise, p.dropout, p.spurious, p.mount_xyz.x(), p.mount_xyz.y(),
-              p.mount_xyz.z());
-  out << Line("  %d scans, %d poses at %.0f Hz (noise %.3f m, %.3f deg)\n", sim.NumScans(),
-              sim.NumPoses(), sim.pose_rate_hz(), sim.pose_noise().position,
-              sim.pose_noise().yaw_deg);
+  out << Format("  duration %.2f s, seed %llu, start_utime %lld\n", sc.duration,
+                static_cast<unsigned long long>(sim.seed()),
+                static_cast<long long>(sc.start_utime));
+  out << Format("  sensor %s: %d layers x %d columns, %.1f Hz, fov %.0f deg, max range %.0f m, "
+                "noise %.3f m, dropout %.3f, spurious %.3f; mounted at (%.2f, %.2f, %.2f)\n",
+                p.name.c_str(), p.NumLayers(), p.NumColumns(), p.rate_hz, p.fov_deg, p.max_range,
+                p.range_noise, p.dropout, p.spurious, p.mount_xyz.x(), p.mount_xyz.y(),
+                p.mount_xyz.z());
+  out << Format("  %d scans, %d poses at %.0f Hz (noise %.3f m, %.3f deg)\n", sim.NumScans(),
+                sim.NumPoses(), sim.pose_rate_hz(), sim.pose_noise().position,
+                sim.pose_noise().yaw_deg);
   std::map<std::string, int> count, moving;
   for (const auto& o : sc.scene.objects) {
     ++count[ObjectClassName(o.object_class)];
@@ -146,25 +139,26 @@ void Describe(const Simulator& sim, std::ostream& out) {
       s.start.center = s.start.axis_point;
       s.end.center = s.end.axis_point;
     }
-    out << Line("  %-12s start (%7.2f, %7.2f) %7.1f deg -> end (%7.2f, %7.2f) %7.1f deg; "
-                "turned %+7.1f deg over %6.1f m; speed %.1f..%.1f m/s; centre within "
-                "x [%.1f, %.1f] y [%.1f, %.1f]\n",
-                who, s.start.center.x(), s.start.center.y(), RadToDeg(s.start.yaw),
-                s.end.center.x(), s.end.center.y(), RadToDeg(s.end.yaw), RadToDeg(s.turned),
-                s.distance, s.min_speed, s.max_speed, s.box.min().x(), s.box.max().x(),
-                s.box.min().y(), s.box.max().y());
+    out << Format("  %-12s start (%7.2f, %7.2f) %7.1f deg -> end (%7.2f, %7.2f) %7.1f deg; "
+                  "turned %+7.1f deg over %6.1f m; speed %.1f..%.1f m/s; centre within "
+                  "x [%.1f, %.1f] y [%.1f, %.1f]\n",
+                  who, s.start.center.x(), s.start.center.y(), RadToDeg(s.start.yaw),
+                  s.end.center.x(), s.end.center.y(), RadToDeg(s.end.yaw), RadToDeg(s.turned),
+                  s.distance, s.min_speed, s.max_speed, s.box.min().x(), s.box.max().x(),
+                  s.box.min().y(), s.box.max().y());
   };
   out << "  paths (box centre; the ego's is its body origin, the rear axle):\n";
   path("ego", *sc.scene.ego.motion, true);
   for (const auto& o : sc.scene.objects) {
     if (!o.moving()) continue;
-    const std::string who = Line("%s %lld", ObjectClassName(o.object_class), static_cast<long long>(o.id));
+    const std::string who =
+        Format("%s %lld", ObjectClassName(o.object_class), static_cast<long long>(o.id));
     path(who.c_str(), *o.motion, false);
   }
   const auto overlaps = FindOverlaps(sc);
   for (const auto& ov : overlaps) {
-    out << Line("  WARNING: %s and %s overlap (%.2f m) at t = %.1f s\n", ov.a.c_str(),
-                ov.b.c_str(), ov.depth, ov.t);
+    out << Format("  WARNING: %s and %s overlap (%.2f m) at t = %.1f s\n", ov.a.c_str(),
+                  ov.b.c_str(), ov.depth, ov.t);
   }
   if (overlaps.empty()) out << "  no overlapping footprints (checked every 0.1 s)\n";
 }

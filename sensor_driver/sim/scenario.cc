@@ -120,6 +120,15 @@ class Reader {
 
   static bool Has(const YAML::Node& map, const char* key) { return map[key].IsDefined(); }
 
+  // True if n (map's value at path at) is defined; false if not and the caller has a default;
+  // refuses a missing key without a default.
+  bool Given(const YAML::Node& map, const YAML::Node& n, const std::string& at,
+             bool has_default) const {
+    if (n.IsDefined()) return true;
+    if (!has_default) Fail(map, at, "required key is missing");
+    return false;
+  }
+
   static std::string Join(const std::string& path, const std::string& key) {
     return path.empty() ? key : path + "." + key;
   }
@@ -130,10 +139,7 @@ class Reader {
              bool hi_open = false) const {
     const YAML::Node n = map[key];
     const std::string at = Join(path, key);
-    if (!n.IsDefined()) {
-      if (!def) Fail(map, at, "required key is missing");
-      return *def;
-    }
+    if (!Given(map, n, at, def.has_value())) return *def;
     const double v = ScalarNumber(n, at);
     const bool ok = (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
     if (!ok) {
@@ -160,10 +166,7 @@ class Reader {
                    std::optional<std::int64_t> def, std::int64_t lo, std::int64_t hi) const {
     const YAML::Node n = map[key];
     const std::string at = Join(path, key);
-    if (!n.IsDefined()) {
-      if (!def) Fail(map, at, "required key is missing");
-      return *def;
-    }
+    if (!Given(map, n, at, def.has_value())) return *def;
     if (!n.IsScalar()) Fail(n, at, "expected an integer");
     std::int64_t v;
     try {
@@ -192,10 +195,7 @@ class Reader {
                   std::optional<std::string> def) const {
     const YAML::Node n = map[key];
     const std::string at = Join(path, key);
-    if (!n.IsDefined()) {
-      if (!def) Fail(map, at, "required key is missing");
-      return *def;
-    }
+    if (!Given(map, n, at, def.has_value())) return *def;
     if (!n.IsScalar()) Fail(n, at, "expected a string");
     return n.Scalar();
   }
@@ -315,23 +315,17 @@ class Builder {
   }
 
   void Vehicles(Scenario* sc) {
-    const YAML::Node list = root_["vehicles"];
-    if (!list.IsDefined()) return;
-    r_.ExpectSeq(list, "vehicles");
     // Explicit ids first, so that automatic ones never collide with them.
-    for (std::size_t i = 0; i < list.size(); ++i) {
-      const std::string p = "vehicles[" + std::to_string(i) + "]";
-      r_.ExpectMap(list[i], p);
-      if (Reader::Has(list[i], "id")) {
-        const std::int64_t id = r_.Int(list[i], p, "id", std::nullopt, 1, 1'000'000'000);
+    ForEachItem(root_["vehicles"], "vehicles", [&](const YAML::Node& v, const std::string& p) {
+      r_.ExpectMap(v, p);
+      if (Reader::Has(v, "id")) {
+        const std::int64_t id = r_.Int(v, p, "id", std::nullopt, 1, 1'000'000'000);
         if (!explicit_ids_.insert(id).second) {
-          r_.Fail(list[i]["id"], p + ".id = " + std::to_string(id), "is used twice");
+          r_.Fail(v["id"], p + ".id = " + std::to_string(id), "is used twice");
         }
       }
-    }
-    for (std::size_t i = 0; i < list.size(); ++i) {
-      const YAML::Node v = list[i];
-      const std::string p = "vehicles[" + std::to_string(i) + "]";
+    });
+    ForEachItem(root_["vehicles"], "vehicles", [&](const YAML::Node& v, const std::string& p) {
       r_.CheckKeys(v, p, {"id", "class", "steering", "length", "width", "height", "wheelbase",
                           "rear_axle_offset", "rotation_axis_offset", "reflectance", "start",
                           "profile"});
@@ -349,16 +343,11 @@ class Builder {
       auto motion = MakeMotion(v, p, mp, c, yaw, speed, turn);
       if (!motion->IsStatic()) o.motion = std::move(motion);
       sc->scene.objects.push_back(o);
-    }
+    });
   }
 
   void Traffic(Scenario* sc) {
-    const YAML::Node list = root_["traffic"];
-    if (!list.IsDefined()) return;
-    r_.ExpectSeq(list, "traffic");
-    for (std::size_t i = 0; i < list.size(); ++i) {
-      const YAML::Node g = list[i];
-      const std::string p = "traffic[" + std::to_string(i) + "]";
+    ForEachItem(root_["traffic"], "traffic", [&](const YAML::Node& g, const std::string& p) {
       r_.ExpectMap(g, p);
       const std::string kind = r_.Choice(g, p, "kind", std::nullopt, {"lane", "ring"});
       const std::vector<std::string> common = {"kind", "class", "count", "speed", "length",
@@ -426,16 +415,11 @@ class Builder {
         if (!motion->IsStatic()) o.motion = std::move(motion);
         sc->scene.objects.push_back(o);
       }
-    }
+    });
   }
 
   void Parked(Scenario* sc) {
-    const YAML::Node list = root_["parked"];
-    if (!list.IsDefined()) return;
-    r_.ExpectSeq(list, "parked");
-    for (std::size_t i = 0; i < list.size(); ++i) {
-      const YAML::Node v = list[i];
-      const std::string p = "parked[" + std::to_string(i) + "]";
+    ForEachItem(root_["parked"], "parked", [&](const YAML::Node& v, const std::string& p) {
       r_.CheckKeys(v, p, {"class", "x", "y", "yaw_deg", "length", "width", "height", "wheelbase",
                           "rear_axle_offset", "rotation_axis_offset", "reflectance", "count",
                           "spacing", "direction_deg", "skip"});
@@ -451,17 +435,12 @@ class Builder {
         o.center = c;
         sc->scene.objects.push_back(o);
       }
-    }
+    });
   }
 
   void Walls(Scenario* sc) {
-    const YAML::Node list = root_["walls"];
-    if (!list.IsDefined()) return;
-    r_.ExpectSeq(list, "walls");
     const ClassDefaults d = DefaultsFor(ObjectClass::kWall);
-    for (std::size_t i = 0; i < list.size(); ++i) {
-      const YAML::Node w = list[i];
-      const std::string p = "walls[" + std::to_string(i) + "]";
+    ForEachItem(root_["walls"], "walls", [&](const YAML::Node& w, const std::string& p) {
       r_.CheckKeys(w, p, {"from", "to", "thickness", "height", "reflectance"});
       const Eigen::Vector2d a = r_.Point(w, p, "from"), b = r_.Point(w, p, "to");
       if ((b - a).norm() < 0.1) r_.Fail(w, p, "from and to must be at least 0.1 m apart");
@@ -479,17 +458,12 @@ class Builder {
       o.reflectance = r_.Num(w, p, "reflectance", d.reflectance, 0.0, 1.0);
       o.rotation_axis_offset = std::nan("");
       sc->scene.objects.push_back(o);
-    }
+    });
   }
 
   void Round(Scenario* sc, const char* key, ObjectClass cls) {
-    const YAML::Node list = root_[key];
-    if (!list.IsDefined()) return;
-    r_.ExpectSeq(list, key);
     const ClassDefaults d = DefaultsFor(cls);
-    for (std::size_t i = 0; i < list.size(); ++i) {
-      const YAML::Node v = list[i];
-      const std::string p = std::string(key) + "[" + std::to_string(i) + "]";
+    ForEachItem(root_[key], key, [&](const YAML::Node& v, const std::string& p) {
       std::vector<std::string> keys = {"x", "y", "radius", "height", "reflectance", "count",
                                        "spacing", "direction_deg", "skip"};
       if (cls == ObjectClass::kBush) keys.push_back("penetration");
@@ -509,10 +483,21 @@ class Builder {
         o.center = c;
         sc->scene.objects.push_back(o);
       }
-    }
+    });
   }
 
  private:
+  // Calls fn(item, item_path) for each item of the list at path (none if list is absent),
+  // item_path being "path[i]". Refuses a list that is not a sequence.
+  template <class Fn>
+  void ForEachItem(const YAML::Node& list, const std::string& path, Fn fn) {
+    if (!list.IsDefined()) return;
+    r_.ExpectSeq(list, path);
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      fn(list[i], path + "[" + std::to_string(i) + "]");
+    }
+  }
+
   std::int64_t NextId() {
     while (explicit_ids_.count(next_id_)) ++next_id_;
     return next_id_++;

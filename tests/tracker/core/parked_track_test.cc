@@ -38,7 +38,7 @@ constexpr std::int64_t kStep = 100'000;  // [us] 10 Hz
 // A track manager with the default parameters, the sensor at the origin, and the scans' clock.
 struct Scans {
   const Ekf ekf;
-  const TrackManagerParams params;
+  const TrackManagerParams params{};
   TrackManager m{params, ekf, FitParams(), ShapeParams()};
   const Eigen::Vector2d sensor{0.0, 0.0};
   std::int64_t t = 1'000'000'000;  // [us] the current scan's time

@@ -341,6 +341,8 @@ int RunCompare(const CompareOptions& o) {
                                            tracks, "--mode", mode};
           if (item.kind == CompareItem::Kind::kKittiBoxes) {
             argv.insert(argv.end(), {"--input-mode", "boxes"});
+          } else if (item.kind == CompareItem::Kind::kKitti) {
+            argv.insert(argv.end(), {"--input-mode", item.input_mode});
           }
           if (!o.tracker_config.empty()) argv.insert(argv.end(), {"--config", o.tracker_config});
           say(item.name + " / " + mode + ": " + Join(argv));

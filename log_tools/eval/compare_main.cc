@@ -29,7 +29,7 @@ int main(int argc, char** argv) {
   CompareOptions o;
   std::string scenarios, modes = "ism,vasm,mht";
   std::vector<std::string> kitti_dirs;
-  std::string kitti_boxes_dir, sequences;
+  std::string kitti_boxes_dir, sequences, kitti_input_modes = "scans";
 
   po::options_description desc(
       "vtrack-compare --scenarios a,b [--kitti DIR] [options]\n"
@@ -41,6 +41,9 @@ int main(int argc, char** argv) {
     ("scenarios", po::value(&scenarios), "comma-separated scenario NAMEs or YAML paths")
     ("kitti", po::value(&kitti_dirs), "KITTI tracking directory (repeatable); scored in camera 2's "
                                       "view within --kitti-range, named kitti_<sequence>")
+    ("kitti-input-modes", po::value(&kitti_input_modes)->default_value(kitti_input_modes),
+     "with --kitti: comma-separated vtrack-tracker input modes, scans and/or fused (scans and\n"
+     "the sequence's detections/pointrcnn_Car boxes); a fused item is named kitti_<sequence>_fused")
     ("kitti-sequence", po::value(&o.kitti_sequence)->default_value(o.kitti_sequence), "KITTI sequence")
     ("kitti-boxes", po::value(&kitti_boxes_dir),
      "KITTI folder of the boxes layout (label_02/, calib/, detections/pointrcnn_Car/,\n"
@@ -84,12 +87,23 @@ int main(int argc, char** argv) {
         throw std::invalid_argument(std::string("--kitti-sequence: ") + e.what());
       }
     }
+    const std::vector<std::string> input_modes = SplitList(kitti_input_modes);
+    if (input_modes.empty()) throw std::invalid_argument("--kitti-input-modes is empty");
+    for (const auto& m : input_modes) {
+      if (m != "scans" && m != "fused") {
+        throw std::invalid_argument("--kitti-input-modes: '" + m + "' is not scans or fused (boxes "
+                                    "alone: --kitti-boxes, whose labels share the boxes' time)");
+      }
+    }
     for (const auto& d : kitti_dirs) {
-      CompareItem item;
-      item.kind = CompareItem::Kind::kKitti;
-      item.source = d;
-      item.name = "kitti_" + o.kitti_sequence;
-      o.items.push_back(item);
+      for (const auto& m : input_modes) {
+        CompareItem item;
+        item.kind = CompareItem::Kind::kKitti;
+        item.source = d;
+        item.input_mode = m;
+        item.name = "kitti_" + o.kitti_sequence + (m == "scans" ? "" : "_" + m);
+        o.items.push_back(item);
+      }
     }
     if (!sequences.empty() && kitti_boxes_dir.empty()) {
       throw std::invalid_argument("--sequences goes with --kitti-boxes");

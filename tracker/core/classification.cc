@@ -30,8 +30,16 @@ std::optional<bool> MoverTest::Evidence(const Ekf& ekf, const Track& t, bool pos
   return false;
 }
 
-ObjectClass Classify(const TrackManagerParams& params, const Track& t) {
+ObjectClass Classify(const TrackManagerParams& params, const Track& t, bool vehicle_needs_box,
+                     std::int64_t utime) {
   if (t.small_object) return ObjectClass::kOther;
+  if (vehicle_needs_box) {
+    // The detector is the vehicle evidence: a vehicle while the boxes alone would keep it a
+    // confirmed track (confirm_updates boxes, the latest within coast_max_s).
+    const double since_box_s = static_cast<double>(utime - t.last_box_utime) * 1e-6;
+    const bool box_track = t.box_updates >= params.confirm_updates && since_box_s <= params.coast_max_s;
+    return box_track ? ObjectClass::kVehicle : ObjectClass::kOther;
+  }
   if (t.box_updates > 0) return ObjectClass::kVehicle;
   const TrackHypothesis& sel = t.hyps[static_cast<std::size_t>(t.selected)];
   const double est_l = sel.length_est.value_or(0.0), est_w = sel.width_est.value_or(0.0);

@@ -33,6 +33,7 @@ class MoverTest {
 // or a face of a car's front or rear width was seen whole and the rest fits, or it is a mover of
 // any plausible size, or a vehicle detector's box measured it; otherwise other. Small objects
 // are other.
-ObjectClass Classify(const TrackManagerParams& params, const Track& t);
+ObjectClass Classify(const TrackManagerParams& params, const Track& t, bool vehicle_needs_box = false,
+                     std::int64_t utime = 0);
 
 }  // namespace vtrack

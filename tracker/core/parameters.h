@@ -504,6 +504,7 @@ struct DetectionParams {
   double gate_m = 2.0;
   double gate_sigma = 3.0;
   double max_gate_m = 5.0;
+  bool fused_vehicle_needs_box = true;
 
   template <class V>
   void Visit(V& v) {
@@ -516,6 +517,7 @@ struct DetectionParams {
     v("gate_m", &gate_m, {"m", Above(0), "a box farther than this (+ gate_sigma predicted position stds) from a track is not its candidate"});
     v("gate_sigma", &gate_sigma, {"-", AtLeast(0), "predicted position stds added to gate_m"});
     v("max_gate_m", &max_gate_m, {"m", OpenClosed(0, 50), "upper bound of the whole gate (>= gate_m)"});
+    v("fused_vehicle_needs_box", &fused_vehicle_needs_box, {"-", {}, "fused: a track is a vehicle only while its boxes would confirm it (manager.confirm_updates boxes, the latest within manager.coast_max_s); scan-only tracks are other: the size rules alone class walls and hedges as cars"});
   }
   // gate_m <= max_gate_m.
   std::string CrossProblem() const;

@@ -61,6 +61,7 @@ struct Track {
   bool axis_from_full_face = false;       // heading set by a fully seen short face (AlignToFullFace)
   double full_face_extent = 0.0;          // [m] that face's extent (a car's front or rear width)
   int box_updates = 0;                    // [-] updates (and creation) by a detector's box
+  std::int64_t last_box_utime = -1;       // [us] time of the latest box update; -1 = never
   std::vector<TrackHypothesis> hyps;
   int selected = 0;                       // index into hyps of the reported hypothesis
 };

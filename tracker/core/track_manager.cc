@@ -274,7 +274,10 @@ void TrackManager::UpdateWithBox(std::size_t index, const BoxMeasurement& b,
       any = true;
     }
   }
-  if (any) ++t.box_updates;
+  if (any) {
+    ++t.box_updates;
+    t.last_box_utime = b.utime;
+  }
   AfterUpdate(any, tm, /*pose_measured=*/true, &t);
 }
 
@@ -310,6 +313,7 @@ bool TrackManager::CreateFromBox(const BoxMeasurement& b, const DetectionParams&
   ObserveBoxShape(b, static_cast<double>(b.utime) * 1e-6, &h);
   Track t;
   t.box_updates = 1;
+  t.last_box_utime = b.utime;
   AddTrack(std::move(t), std::move(h), b.utime);
   return true;
 }
@@ -430,7 +434,7 @@ void TrackManager::Report(std::int64_t utime, std::vector<TrackReport>* out) con
     r.num_hypotheses = static_cast<int>(t.hyps.size());
     r.age = static_cast<double>(utime - t.created_utime) * 1e-6;
     r.num_updates = t.num_updates;
-    r.object_class = Classify(params_, t);
+    r.object_class = Classify(params_, t, vehicle_needs_box_, utime);
     if (r.object_class != ObjectClass::kVehicle && sel.length_est && sel.width_est) {
       // Clutter: its own size, not the vehicle default.
       r.length = *sel.length_est;

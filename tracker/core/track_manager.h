@@ -115,6 +115,9 @@ class TrackManager {
   // The id of the next track (>= 1; ids then count up from it). A process that restarts gives
   // a larger one than any id it gave before (the live tracker: from the wall clock).
   void SetNextId(std::int64_t id) { next_id_ = id; }
+  // Fused input: the detector is the vehicle evidence, so a track no box has updated is
+  // reported as other, whatever its size (see DetectionParams::fused_vehicle_needs_box).
+  void SetVehicleNeedsBox(bool needs_box) { vehicle_needs_box_ = needs_box; }
   const std::vector<Track>& tracks() const { return tracks_; }
   const TrackManagerParams& params() const { return params_; }
 
@@ -160,6 +163,7 @@ class TrackManager {
   MoverTest mover_test_;
   std::vector<Track> tracks_;
   std::int64_t next_id_ = 1;
+  bool vehicle_needs_box_ = false;
 };
 
 }  // namespace vtrack

@@ -54,6 +54,8 @@ Tracker::Tracker(const TrackerParams& params, bool debug)
   if (!params_.Validate(&error)) throw std::invalid_argument(error);
   ekf_ = std::make_unique<Ekf>(params_.ism, params_.vasm, params_.ekf);
   manager_ = std::make_unique<TrackManager>(params_.manager, *ekf_, params_.fit, params_.shape);
+  manager_->SetVehicleNeedsBox(params_.detections.mode == InputMode::kFused &&
+                               params_.detections.fused_vehicle_needs_box);
 }
 
 std::int64_t FirstTrackIdAt(std::int64_t wall_utime) {
@@ -196,8 +198,14 @@ void Tracker::UpdateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_
                    std::max(kMinProfileBinDeg, params_.outline.bin_deg));
   }
   const std::size_t num_tracks = manager_->tracks().size();
+  // Fused: a track a box of this frame has updated (the frame's list is processed before its
+  // scan) is neither updated nor missed by the scan. The outline of a partly seen car is biased
+  // towards the sensor where the detector's box is not (KITTI 0000: MOTP 0.34 m with both,
+  // 0.23 m with the box alone); the scan measures the tracks in the frames the detector misses.
+  const bool fused = params_.detections.mode == InputMode::kFused;
   for (std::size_t j = 0; j < num_tracks; ++j) {
     const auto& idx = association_.track_points[j];
+    if (fused && manager_->tracks()[j].last_box_utime >= scan.utime) continue;
     if (idx.empty()) {
       manager_->Miss(j);
       continue;

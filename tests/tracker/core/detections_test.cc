@@ -7,10 +7,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <random>
 #include <set>
 
 #include "base/angle.h"
+#include "tests/tracker/core/synthetic_scene.h"
 #include "tracker/core/tracker.h"
 
 namespace vtrack {
@@ -165,6 +167,107 @@ TEST(TrackerBoxes, RefusesAListWithANonFiniteBoxAndIgnoresBoxesWithScansOnly) {
   l2.boxes.push_back(d);
   t2.AddDetections(std::move(l2), &out);
   EXPECT_TRUE(t2.rejects().empty());
+}
+
+
+// Fused input on the seeded single-plane scene: a parked car seen by the LADAR only and a
+// turning car that the detector also boxes (0.1 m noise, at the middle of each sweep), with the
+// detector silent for 0.5 s (frames 20-24) and for good from frame 40 on.
+struct FusedRun {
+  std::map<int, std::set<std::int64_t>> ids;             // object -> ids of tracks within 1.5 m
+  std::map<int, std::map<int, ObjectClass>> class_at;   // object -> frame -> class of that track
+  std::map<int, double> max_error;                       // object -> worst centre error [m]
+};
+
+FusedRun RunFused(bool vehicle_needs_box) {
+  using testing::AckermannPath;
+  const std::vector<testing::SceneObject> objects = {
+      {1, AckermannPath({16.0, 7.0}, 0.3, 0.0, 0.0, -1.4)},  // parked: scans only
+      {2, AckermannPath({4.0, -8.0}, 0.0, 7.0, 0.2, -1.4)},  // turning: scans and boxes
+  };
+  testing::SyntheticScene scene(testing::SceneConfig{}, objects, 11);
+  TrackerParams params;
+  params.detections.mode = InputMode::kFused;
+  params.detections.fused_vehicle_needs_box = vehicle_needs_box;
+  Tracker tracker(params);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.1);
+  FusedRun run;
+  std::vector<ScanOutput> out;
+  for (int tick = 0; tick <= 600; ++tick) {
+    const double t = tick * 0.01;
+    tracker.AddPose(scene.PoseAt(t), &out);
+    if (tick < 10 || tick % 10 != 0) continue;
+    const int frame = tick / 10 - 1;
+    const double t_scan = t - 0.1;
+    if (frame < 20 || (frame >= 25 && frame < 40)) {
+      const double t_box = t_scan + 0.05;  // the middle of the sweep, as KITTI's labels
+      const OrientedBox b = objects[1].box_at(t_box);
+      const Eigen::Isometry3d ego = scene.EgoAt(t_box);
+      const Eigen::Vector3d c = ego.inverse() * Eigen::Vector3d(b.center.x(), b.center.y(), 0.0);
+      DetectionList list;
+      list.utime = scene.Utime(t_box);
+      list.seq = frame;
+      Detection d;
+      d.x = c.x() + noise(rng);
+      d.y = c.y() + noise(rng);
+      d.yaw = b.theta;  // the ego does not turn
+      d.length = b.length;
+      d.width = b.width;
+      d.height = 1.5;
+      d.score = 8.0;
+      list.boxes.push_back(d);
+      tracker.AddDetections(std::move(list), &out);
+    }
+    out.clear();
+    tracker.AddScan(scene.ScanAt(t_scan, frame), &out);
+    for (const ScanOutput& o : out) {
+      const double to = (o.utime - scene.Utime(0.0)) * 1e-6;
+      for (const auto& obj : objects) {
+        const OrientedBox truth = obj.box_at(to + 0.05);
+        for (const TrackReport& r : o.tracks) {
+          if (r.status != TrackStatus::kConfirmed) continue;
+          const double e = std::hypot(r.x - truth.center.x(), r.y - truth.center.y());
+          if (e > 1.5) continue;
+          run.ids[obj.id].insert(r.id);
+          run.class_at[obj.id][frame] = r.object_class;
+          if (frame >= 10) run.max_error[obj.id] = std::max(run.max_error[obj.id], e);
+        }
+      }
+    }
+  }
+  return run;
+}
+
+TEST(TrackerFused, TheDetectorDecidesTheVehicleClassAndScansCarryTheTrackThroughItsGaps) {
+  const FusedRun run = RunFused(true);
+  // Both cars tracked, each by one track all along.
+  ASSERT_EQ(run.ids.count(1), 1u);
+  ASSERT_EQ(run.ids.count(2), 1u);
+  EXPECT_EQ(run.ids.at(1).size(), 1u);
+  EXPECT_EQ(run.ids.at(2).size(), 1u);
+  // The parked car has no box: a track, but not a vehicle, whatever its size.
+  for (const auto& [frame, c] : run.class_at.at(1)) EXPECT_EQ(c, ObjectClass::kOther) << frame;
+  // The boxed car: a vehicle from its third box on, through the detector's 0.5 s gap (scans
+  // update it), and no longer 1.5 s (manager.coast_max_s) after the detector's last box.
+  const auto& car = run.class_at.at(2);
+  for (int frame : {5, 15, 21, 24, 30, 39, 40, 53}) {
+    ASSERT_TRUE(car.count(frame)) << "frame " << frame;
+    EXPECT_EQ(car.at(frame), ObjectClass::kVehicle) << "frame " << frame;
+  }
+  for (int frame : {55, 57}) {
+    ASSERT_TRUE(car.count(frame)) << "frame " << frame;
+    EXPECT_EQ(car.at(frame), ObjectClass::kOther) << "frame " << frame;
+  }
+  EXPECT_LT(run.max_error.at(2), 0.6);
+}
+
+TEST(TrackerFused, WithoutTheSwitchTheSizeRulesClassTheParkedCarAVehicle) {
+  const FusedRun run = RunFused(false);
+  ASSERT_EQ(run.class_at.count(1), 1u);
+  int vehicle = 0;
+  for (const auto& [frame, c] : run.class_at.at(1)) vehicle += c == ObjectClass::kVehicle;
+  EXPECT_GT(vehicle, 20);
 }
 
 }  // namespace

@@ -286,11 +286,14 @@ int RunCompare(const CompareOptions& o) {
                 "--out", run};
         if (!o.kitti_poses.empty()) argv.insert(argv.end(), {"--poses", o.kitti_poses});
         if (!o.kitti_oxts.empty()) argv.insert(argv.end(), {"--oxts", o.kitti_oxts});
+        const bool boxes_only = item.input_mode == "boxes";
+        if (boxes_only) argv.push_back("--no-scans");  // truth and boxes share the frame's time
         EvalCliOptions kopt = o.eval;
         kopt.kitti_calib = FindKittiCalib(o, item);
         kopt.region_camera = true;
         kopt.region_range_m = o.kitti_range_m;
-        kopt.truth_time_offset = "half-sweep";  // labels are half a sweep after the scan's utime
+        // With scans, the labels are half a sweep after the scan's utime.
+        if (!boxes_only) kopt.truth_time_offset = "half-sweep";
         params = MakeEvalParams(kopt);
       } else {
         argv = {tool("vtrack-kitti2lcm"), "--kitti", item.source, "--sequence", item.sequence,

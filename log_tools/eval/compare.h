@@ -27,7 +27,7 @@ struct CompareItem {
   std::string name;      // [-] key in the table and the JSON: scenario name, or kitti_<sequence>
   std::string source;    // [-] scenario NAME or path; KITTI directory
   std::string sequence;  // [-] kKittiBoxes: its sequence
-  std::string input_mode = "scans";  // [-] kKitti: vtrack-tracker --input-mode (scans | fused)
+  std::string input_mode = "scans";  // [-] kKitti: vtrack-tracker --input-mode (scans | boxes | fused)
 };
 
 struct CompareOptions {

@@ -42,8 +42,9 @@ int main(int argc, char** argv) {
     ("kitti", po::value(&kitti_dirs), "KITTI tracking directory (repeatable); scored in camera 2's "
                                       "view within --kitti-range, named kitti_<sequence>")
     ("kitti-input-modes", po::value(&kitti_input_modes)->default_value(kitti_input_modes),
-     "with --kitti: comma-separated vtrack-tracker input modes, scans and/or fused (scans and\n"
-     "the sequence's detections/pointrcnn_Car boxes); a fused item is named kitti_<sequence>_fused")
+     "with --kitti: comma-separated vtrack-tracker input modes: scans, boxes (the sequence's\n"
+     "detections/pointrcnn_Car alone) and/or fused (both); the boxes and fused items are named\n"
+     "kitti_<sequence>_boxes and kitti_<sequence>_fused")
     ("kitti-sequence", po::value(&o.kitti_sequence)->default_value(o.kitti_sequence), "KITTI sequence")
     ("kitti-boxes", po::value(&kitti_boxes_dir),
      "KITTI folder of the boxes layout (label_02/, calib/, detections/pointrcnn_Car/,\n"
@@ -90,9 +91,8 @@ int main(int argc, char** argv) {
     const std::vector<std::string> input_modes = SplitList(kitti_input_modes);
     if (input_modes.empty()) throw std::invalid_argument("--kitti-input-modes is empty");
     for (const auto& m : input_modes) {
-      if (m != "scans" && m != "fused") {
-        throw std::invalid_argument("--kitti-input-modes: '" + m + "' is not scans or fused (boxes "
-                                    "alone: --kitti-boxes, whose labels share the boxes' time)");
+      if (m != "scans" && m != "boxes" && m != "fused") {
+        throw std::invalid_argument("--kitti-input-modes: '" + m + "' is not scans, boxes or fused");
       }
     }
     for (const auto& d : kitti_dirs) {

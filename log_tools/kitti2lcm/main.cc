@@ -51,6 +51,9 @@ int main(int argc, char** argv) {
       ("pose-rate", po::value<double>(&pose_rate_hz)->default_value(100.0), "EGO_POSE rate [Hz], 10..1000")
       ("no-ground-truth", "do not write GROUND_TRUTH")
       ("no-detections", "do not write DETECTIONS (the detector's boxes, where the folder has them)")
+      ("no-scans", po::bool_switch(&seq_opt.no_scans),
+       "do not write LADAR_SCAN: the sequence is written as the boxes layout is (GROUND_TRUTH\n"
+       "and DETECTIONS at each frame's time), for tracking from the boxes alone")
       ("image-width", po::value<int>(&seq_opt.image_width)->default_value(seq_opt.image_width),
        "camera 2 image width [px], for in_labelled_region")
       ("image-height", po::value<int>(&seq_opt.image_height)->default_value(seq_opt.image_height),

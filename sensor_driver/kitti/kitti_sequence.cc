@@ -153,6 +153,7 @@ Sequence::Sequence(SequenceOptions options) : options_(std::move(options)) {
     for (auto& p : world_from_body_) p = inv0 * p;
   }
   world_from_body_.resize(static_cast<std::size_t>(num_frames_));
+  if (options_.no_scans) paths_.velodyne_dir.clear();  // frames counted: read as the boxes layout
   BuildPoseRates();
   detections_.assign(static_cast<std::size_t>(num_frames_), {});
   if (has_detections()) {

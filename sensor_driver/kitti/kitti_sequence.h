@@ -46,6 +46,8 @@ struct SequenceOptions {
                                    //     this radius about its mean position; > 0
   int velocity_half_window = 5;    // [frames] vx, vy, yaw_rate: least-squares slope over the track's
                                    //     labels within +-this many frames; >= 1
+  bool no_scans = false;           // [-] leave the point clouds out: the sequence reads as the
+                                   //     boxes layout (truth stamped with the frame's time)
   MessageSink sink;                // progress messages; nullptr = stderr
 
   // Empty if valid, else a message naming the key and its value.

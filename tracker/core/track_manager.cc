@@ -277,6 +277,7 @@ void TrackManager::UpdateWithBox(std::size_t index, const BoxMeasurement& b,
   if (any) {
     ++t.box_updates;
     t.last_box_utime = b.utime;
+    t.small_object = false;  // the box is a full view of a vehicle's rectangle
   }
   AfterUpdate(any, tm, /*pose_measured=*/true, &t);
 }

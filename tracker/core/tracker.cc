@@ -200,8 +200,9 @@ void Tracker::UpdateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_
   const std::size_t num_tracks = manager_->tracks().size();
   // Fused: a track a box of this frame has updated (the frame's list is processed before its
   // scan) is neither updated nor missed by the scan. The outline of a partly seen car is biased
-  // towards the sensor where the detector's box is not (KITTI 0000: MOTP 0.34 m with both,
-  // 0.23 m with the box alone); the scan measures the tracks in the frames the detector misses.
+  // towards the sensor where the detector's box is not (KITTI 0000, mht: MOTA 0.64 and MOTP
+  // 0.27 m with both updates, 0.78 and 0.21 m with the box alone); the scan measures the tracks
+  // in the frames the detector misses.
   const bool fused = params_.detections.mode == InputMode::kFused;
   for (std::size_t j = 0; j < num_tracks; ++j) {
     const auto& idx = association_.track_points[j];

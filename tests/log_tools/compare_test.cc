@@ -107,6 +107,37 @@ TEST_F(CompareTest, ThreeModesOnTwoScenariosAndKitti) {
   }
 }
 
+// --kitti-input-modes: one item per input mode; the boxes item is converted without scans (its
+// labels then share the frame's time: no half-sweep offset), the fused one tracked with both.
+TEST_F(CompareTest, KittiInputModesGiveOneItemEach) {
+  const std::string kitti = dir_ + "/kitti_modes";
+  fs::create_directories(kitti + "/calib");
+  {
+    std::ofstream c(kitti + "/calib/0000.txt");
+    const char* p = "500 0 600 0 0 500 180 0 0 0 1 0";
+    c << "P0: " << p << "\nP1: " << p << "\nP2: " << p << "\nP3: " << p << "\n"
+      << "R0_rect: 1 0 0 0 1 0 0 0 1\nTr_velo_to_cam: 0 -1 0 0 0 0 -1 0 1 0 0 0\n";
+  }
+  const std::string json = dir_ + "/modes.json", calls = dir_ + "/modes_calls.txt";
+  std::string out;
+  EXPECT_EQ(RunTool({"--kitti", kitti, "--kitti-input-modes", "scans,lidar", "--bin-dir", fake_bin_},
+                    &out), 2);
+  EXPECT_NE(out.find("'lidar'"), std::string::npos) << out;
+  ASSERT_EQ(RunTool({"--kitti", kitti, "--kitti-input-modes", "scans,boxes,fused", "--modes", "mht",
+                     "--bin-dir", fake_bin_, "--json", json},
+                    &out, {"FAKE_TOOL_LOG=" + calls}), 0) << out;
+  const std::string c = ReadFile(calls);
+  EXPECT_NE(c.find("--sequence 0000 --out run.lcm --no-scans"), std::string::npos) << c;
+  EXPECT_NE(c.find("--mode mht --input-mode boxes"), std::string::npos) << c;
+  EXPECT_NE(c.find("--mode mht --input-mode fused"), std::string::npos) << c;
+  EXPECT_NE(c.find("--mode mht --input-mode scans"), std::string::npos) << c;
+  const YAML::Node j = YAML::LoadFile(json);
+  ASSERT_EQ(j.size(), 3u);
+  EXPECT_NEAR(j["kitti_0000"]["mht"]["params"]["truth_time_offset_s"].as<double>(), 0.05, 1e-12);
+  EXPECT_NEAR(j["kitti_0000_fused"]["mht"]["params"]["truth_time_offset_s"].as<double>(), 0.05, 1e-12);
+  EXPECT_NEAR(j["kitti_0000_boxes"]["mht"]["params"]["truth_time_offset_s"].as<double>(), 0.0, 1e-12);
+}
+
 TEST_F(CompareTest, AFailedModeIsReportedAndTheRestStillScored) {
   const std::string json = dir_ + "/cmp.json";
   std::string out;

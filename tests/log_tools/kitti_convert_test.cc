@@ -143,6 +143,28 @@ TEST(KittiConvertTest, SyntheticLogHasEveryChannelInTimeOrder) {
   EXPECT_EQ(last_pose, seq.LastPoseUtime());
 }
 
+// Without scans (--no-scans) a raw sequence is written as the boxes layout is: no LADAR_SCAN,
+// the ground truth stamped with each frame's time (half a sweep after the scan's start).
+TEST(KittiConvertTest, NoScansStampsTheTruthWithTheFrameTime) {
+  SequenceOptions so = WriteSyntheticOptions("kitti_convert_no_scans");
+  so.no_scans = true;
+  const Sequence seq(so);
+  EXPECT_FALSE(seq.has_scans());
+  ConvertOptions co;
+  co.out = so.dir + "/out.lcm";
+  ConvertSequence(seq, co, nullptr);
+  std::map<std::string, int> count;
+  for (const auto& e : ReadLog(co.out)) {
+    ++count[e.channel];
+    if (e.channel == "GROUND_TRUTH") {
+      EXPECT_EQ(e.utime, seq.FrameUtime(static_cast<int>(e.seq)));
+      EXPECT_NE(e.utime, seq.ScanUtime(static_cast<int>(e.seq)));
+    }
+  }
+  EXPECT_EQ(count["LADAR_SCAN"], 0);
+  EXPECT_EQ(count["GROUND_TRUTH"], 6);
+}
+
 // At a rate whose period does not divide the frame period, every frame still has its own pose.
 TEST(KittiConvertTest, EveryFrameHasItsPoseAtAnyRate) {
   const SequenceOptions so = WriteSyntheticOptions("kitti_convert_rate");

@@ -45,6 +45,7 @@ struct Injector {
   std::function<void(int i, const ladar_scan_t& scan, TrackerNode& node)> before_scan;
   std::function<void(int k, const pose_t& pose, TrackerNode& node)> before_pose;
   std::function<void(int i, ladar_scan_t* scan)> edit_scan;  // npoints = -1: the scan is lost
+  std::function<bool(int k)> lose_pose;                       // true: pose k is lost
 };
 
 class BadInputTest : public ::testing::Test {
@@ -90,8 +91,10 @@ class BadInputTest : public ::testing::Test {
       if (pose_next) {
         sim_->MakePose(k, start, &pose);
         if (inj.before_pose) inj.before_pose(k, pose, *node);
-        const auto b = Encode(pose);
-        node->Handle("EGO_POSE", b.data(), b.size());
+        if (!inj.lose_pose || !inj.lose_pose(k)) {
+          const auto b = Encode(pose);
+          node->Handle("EGO_POSE", b.data(), b.size());
+        }
         ++k;
       } else {
         sim_->MakeScan(i, start, i, &scan, &truth);
@@ -255,6 +258,67 @@ TEST_F(BadInputTest, NanAndInfReturnsGiveTheTracksOfTheScanWithoutThem) {
   EXPECT_EQ(differ, 0);
 }
 
+TEST_F(BadInputTest, AbsurdReturnsScansAndPosesAreRefusedAndCounted) {
+  // Returns no sensor can have measured (3e38 m, twice the scan's max_range, a ring outside
+  // [0, num_rings)) are refused one by one: the tracks are those of the scans without them.
+  // Scans with a negative num_rings or a NaN / negative max_range, and ego poses 1e300 m or
+  // 2e7 m away, are refused whole: every TRACKS message as in the clean run.
+  const Output clean = Run({});
+  Injector inj;
+  int far = 0, bad_ring = 0;
+  ladar_scan_t previous;
+  inj.edit_scan = [&](int i, ladar_scan_t* s) {
+    if (i % 3 != 1) return;
+    auto add = [&](float x, float y, std::int16_t ring) {
+      s->x.push_back(x); s->y.push_back(y); s->z.push_back(0.0f);
+      s->intensity.push_back(0.5f); s->dt_us.push_back(0); s->ring.push_back(ring);
+    };
+    add(3e38f, 1.0f, 0); add(-2.0f, 3e38f, 0); add(2.0f * s->max_range, 0.0f, 0);
+    far += 3;
+    add(5.0f, 1.0f, s->num_rings); add(6.0f, -1.0f, -1); add(7.0f, 0.0f, 32767);
+    bad_ring += 3;
+    s->npoints = static_cast<std::int32_t>(s->x.size());
+  };
+  inj.before_scan = [&](int i, const ladar_scan_t& scan, TrackerNode& node) {
+    if (i == 9) {  // same seq as the previous scan: not a gap
+      ladar_scan_t s = previous;
+      s.utime = previous.utime + 1;
+      s.num_rings = -3;
+      Send(node, "LADAR_SCAN", Encode(s));
+      s.num_rings = previous.num_rings;
+      s.max_range = std::numeric_limits<float>::quiet_NaN();
+      Send(node, "LADAR_SCAN", Encode(s));
+      s.max_range = -80.0f;
+      Send(node, "LADAR_SCAN", Encode(s));
+    }
+    previous = scan;
+  };
+  inj.before_pose = [&](int k, const pose_t& pose, TrackerNode& node) {
+    if (k == 40) {
+      pose_t p = pose;
+      p.utime -= 1;
+      p.pos[0] = 1e300;
+      Send(node, "EGO_POSE", Encode(p));
+      p.pos[0] = pose.pos[0];
+      p.pos[1] = -2e7;
+      Send(node, "EGO_POSE", Encode(p));
+    }
+  };
+  std::unique_ptr<TrackerNode> node;
+  const Output bad = Run(inj, &node);
+  auto r = Reasons(*node);
+  for (const auto& [k, v] : r) std::printf("  %s: %lld\n", k.c_str(), static_cast<long long>(v));
+  EXPECT_EQ(r["far_point"], far);
+  EXPECT_EQ(r["bad_ring"], bad_ring);
+  EXPECT_EQ(r["bad_scan"], 3);
+  EXPECT_EQ(r["invalid_pose"], 2);
+  EXPECT_EQ(node->tracker().scans_dropped(), 3);
+  ASSERT_EQ(bad.utimes, clean.utimes);
+  int differ = 0;
+  for (std::size_t j = 0; j < clean.tracks.size(); ++j) differ += bad.tracks[j] != clean.tracks[j];
+  EXPECT_EQ(differ, 0);
+}
+
 TEST_F(BadInputTest, LostScansAreCountedFromSeqGaps) {
   Injector inj;
   int lost = 0;
@@ -270,6 +334,99 @@ TEST_F(BadInputTest, LostScansAreCountedFromSeqGaps) {
   EXPECT_EQ(Reasons(*node)["scan_seq_gap"], lost);
   EXPECT_EQ(node->tracker().scans_received(), sim_->NumScans() - lost);
   EXPECT_GT(out.num_tracks, 0);
+}
+
+TEST_F(BadInputTest, LostPosesAreCountedFromTheStreamsTiming) {
+  // Poses have no seq: the node must infer the lost ones from the gaps in their timing. Single
+  // losses, a burst of 7 and a burst of 30 (a stalled receiver), never in the first 10 poses
+  // (the nominal period is not known yet) nor the last (a loss at the end shows no gap).
+  Injector inj;
+  int lost = 0;
+  inj.lose_pose = [&](int k) {
+    const bool lose = k >= 10 && k < sim_->NumPoses() - 1 &&
+                      (k % 37 == 5 || (k >= 200 && k < 207) || (k >= 400 && k < 430));
+    lost += lose;
+    return lose;
+  };
+  std::unique_ptr<TrackerNode> node;
+  const Output out = Run(inj, &node);
+  ASSERT_GT(lost, 40);
+  EXPECT_EQ(Reasons(*node)["pose_gap"], lost);
+  EXPECT_EQ(node->tracker().poses_received(), sim_->NumPoses() - lost);
+  EXPECT_GT(out.num_tracks, 0);
+  // Without losses nothing is counted.
+  std::unique_ptr<TrackerNode> clean;
+  Run({}, &clean);
+  EXPECT_EQ(Reasons(*clean)["pose_gap"], 0);
+}
+
+// The reasons that count a whole scan, as tracker/README.md lists them: every scan received and
+// not processed is counted under exactly one of them.
+std::int64_t SumOfScanReasons(std::map<std::string, std::int64_t> r) {
+  std::int64_t sum = 0;
+  for (const char* k : {"empty_scan", "huge_scan", "bad_scan", "scan_repeated", "scan_out_of_order",
+                        "scan_overrun", "scan_time_jump", "scan_reset", "pose_missing", "stale_pose"}) {
+    sum += r[k];
+  }
+  return sum;
+}
+
+TEST_F(BadInputTest, EveryScanAtTheSameTimeIsCountedOnceByReason) {
+  // A sensor whose clock is stuck: every scan stamped with the first scan's time, the poses
+  // moving on. All but the first are dropped, and each drop has one reason.
+  Injector inj;
+  std::int64_t first = 0;
+  int sent = 0;
+  inj.edit_scan = [&](int i, ladar_scan_t* s) {
+    if (i == 0) first = s->utime;
+    s->utime = first;
+    ++sent;
+  };
+  std::unique_ptr<TrackerNode> node;
+  Run(inj, &node);
+  const tracker_status_t st = node->Status();
+  const auto r = Reasons(*node);
+  for (const auto& [k, v] : r) std::printf("  %s: %lld\n", k.c_str(), static_cast<long long>(v));
+  ASSERT_EQ(sent, sim_->NumScans());
+  EXPECT_GT(st.scans_dropped, sent / 2);
+  EXPECT_EQ(st.scans_received, sent);
+  EXPECT_EQ(SumOfScanReasons(r), st.scans_dropped);
+  EXPECT_EQ(st.scans_dropped, sent - st.scans_processed);
+}
+
+TEST_F(BadInputTest, ScansBeforeAnyPoseAreCountedOnceByReason) {
+  // Three laps of scans (one continuous clock and seq) before the first pose, then the poses of
+  // the first lap: the queue overflows, the poses jump back in time (a reset, confirmed by the
+  // second pose), and the scans left are flushed without poses.
+  TrackerParams params;
+  params.preprocess.max_points = 5000;
+  TrackerNode node(params, NodeOptions{}, [](std::int64_t, const std::string&, const void*, std::size_t) {});
+  const std::int64_t start = sim_->scenario().start_utime;
+  const std::int64_t lap_us = sim_->ScanOffsetUs(sim_->NumScans() - 1) + 100'000;
+  ladar_scan_t scan;
+  object_list_t truth;
+  int sent = 0;
+  for (int lap = 0; lap < 3; ++lap) {
+    for (int i = 0; i < sim_->NumScans(); ++i) {
+      sim_->MakeScan(i, start + lap * lap_us, lap * sim_->NumScans() + i, &scan, &truth);
+      Send(node, "LADAR_SCAN", Encode(scan));
+      ++sent;
+    }
+  }
+  pose_t pose;
+  for (int k = 0; k < sim_->NumPoses(); ++k) {
+    sim_->MakePose(k, start, &pose);
+    Send(node, "EGO_POSE", Encode(pose));
+  }
+  node.Flush();
+  const tracker_status_t st = node.Status();
+  const auto r = Reasons(node);
+  for (const auto& [k, v] : r) std::printf("  %s: %lld\n", k.c_str(), static_cast<long long>(v));
+  ASSERT_GT(sent, params.input.max_queued_scans);
+  EXPECT_EQ(st.scans_received, sent);
+  EXPECT_GT(st.scans_dropped, 0);
+  EXPECT_EQ(SumOfScanReasons(r), st.scans_dropped);
+  EXPECT_EQ(st.scans_dropped, sent - st.scans_processed);
 }
 
 TEST_F(BadInputTest, ScanWithoutAnyPoseIsCountedAsPoseMissing) {

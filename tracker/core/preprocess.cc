@@ -110,6 +110,13 @@ void Preprocessor::Compensate(const LadarScan& scan, PreprocessStats* stats, Wor
   const double min_r2 = params_.min_range * params_.min_range;
   const double max_r2 = params_.max_range * params_.max_range;
   const bool has_ring = scan.ring.size() == n;
+  // Returns a sensor cannot have measured (finite but absurd: 3e38 m) are refused and counted,
+  // apart from the tracker's own range limits: beyond the sensor's stated max_range (1 % margin
+  // for the rounding of coordinates sent as floats), or beyond kMaxReturnRange if it stated none.
+  const double sensor_max = scan.max_range > 0.0f ? std::min<double>(kMaxReturnRange, 1.01 * scan.max_range)
+                                                  : kMaxReturnRange;
+  const double far_r2 = sensor_max * sensor_max;
+  const int num_rings = scan.num_rings;
   const bool has_dt = scan.dt_us.size() == n;
   const double inv_step = 1.0 / static_cast<double>(step);
   if (fraction_.size() != static_cast<std::size_t>(step) + 1) {
@@ -139,6 +146,14 @@ void Preprocessor::Compensate(const LadarScan& scan, PreprocessStats* stats, Wor
       continue;
     }
     const double r2 = px * px + py * py + pz * pz;
+    if (r2 > far_r2) {
+      ++stats->far;
+      continue;
+    }
+    if (has_ring && (scan.ring[i] < 0 || scan.ring[i] >= num_rings)) {
+      ++stats->bad_ring;
+      continue;
+    }
     if (r2 < min_r2 || r2 > max_r2) {
       ++stats->out_of_range;
       continue;

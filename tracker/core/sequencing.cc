@@ -17,6 +17,12 @@ constexpr double kMaxRotationError = 1e-3;
 // A jump in the sensor's scan seq larger than this is a renumbered sensor, not scans lost.
 constexpr std::uint64_t kMaxSeqGap = 100'000;
 
+// An ego pose farther than this from the world origin, on any axis, is refused as invalid: a
+// local-level world frame spans a region driven in one run (10,000 km is a quarter of the
+// Earth's circumference), and coordinates beyond it (1e300 from a bad source) would make every
+// return placed with the pose absurd and overflow the ground grid's cell arithmetic.
+constexpr double kMaxPoseCoordinate = 1e7;  // [m]
+
 bool IsRotation(const Eigen::Matrix3d& R) {
   return (R.transpose() * R - Eigen::Matrix3d::Identity()).norm() <= kMaxRotationError;
 }
@@ -40,6 +46,50 @@ std::vector<TrackerEvent> RejectCounter::TakeEvents() {
   return e;
 }
 
+std::int64_t StreamGapCounter::period_us() const {
+  if (intervals_.size() < kMinIntervals) return 0;
+  // The median gives the period robustly (the gaps, a change of rate); the mean of the intervals
+  // near it gives it precisely (the median of jittered intervals wanders by a few per cent, which
+  // a long gap multiplies): the mean of those within half a median of it.
+  std::vector<std::int64_t> v(intervals_.begin(), intervals_.end());
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  const double median = static_cast<double>(*mid);
+  double sum = 0.0;
+  int n = 0;
+  for (const std::int64_t d : intervals_) {
+    if (std::abs(static_cast<double>(d) - median) <= 0.5 * median) {
+      sum += static_cast<double>(d);
+      ++n;
+    }
+  }
+  return n > 0 ? static_cast<std::int64_t>(std::llround(sum / n)) : *mid;
+}
+
+std::int64_t StreamGapCounter::Add(std::int64_t utime) {
+  std::int64_t missing = 0;
+  if (have_last_ && utime > last_utime_) {
+    // In 128 bits: the difference of two stamps near the ends of int64 must not overflow.
+    const __int128 d = static_cast<__int128>(utime) - static_cast<__int128>(last_utime_);
+    const std::int64_t period = period_us();
+    if (period > 0 && static_cast<double>(d) > kGapFactor * static_cast<double>(period)) {
+      // Bounded so that the conversion cannot overflow (a stamp jumping by centuries).
+      const double ratio = std::min(1e12, static_cast<double>(d) / static_cast<double>(period));
+      missing = static_cast<std::int64_t>(std::llround(ratio)) - 1;
+    }
+    intervals_.push_back(d > INT64_MAX ? INT64_MAX : static_cast<std::int64_t>(d));
+    if (intervals_.size() > kWindow) intervals_.pop_front();
+  }
+  last_utime_ = utime;
+  have_last_ = true;
+  return missing;
+}
+
+void StreamGapCounter::Clear() {
+  intervals_.clear();
+  have_last_ = false;
+}
+
 ScanSequencer::ScanSequencer(const InputParams& params, std::int64_t max_coast_us,
                              std::int64_t max_points, RejectCounter* rejects)
     : params_(params),
@@ -50,7 +100,10 @@ ScanSequencer::ScanSequencer(const InputParams& params, std::int64_t max_coast_u
 
 void ScanSequencer::Reset(const std::string& why) {
   ++resets_;
-  scans_dropped_ += static_cast<std::int64_t>(queue_.size());
+  // The scans waiting for poses cannot be placed across the jump: dropped, and counted.
+  const auto queued = static_cast<std::int64_t>(queue_.size());
+  scans_dropped_ += queued;
+  rejects_->Count("scan_reset", queued, Str(queued) + " queued scans dropped by a reset");
   queue_.clear();
   detections_.clear();
   have_detections_ = false;
@@ -58,6 +111,8 @@ void ScanSequencer::Reset(const std::string& why) {
   have_scan_ = false;
   have_time_ = false;
   have_seq_ = false;
+  have_detections_seq_ = false;
+  pose_gaps_.Clear();
   rejects_->Event("reset", "tracker reset: " + why);
 }
 
@@ -95,7 +150,8 @@ ScanSequencer::TimeCheck ScanSequencer::CheckTime(std::int64_t utime, const char
   }
   jump_pending_ = true;
   pending_utime_ = utime;
-  rejects_->Count("time_jump_unconfirmed", 1,
+  // A scan has its own reason, so that every dropped scan is counted under a scan reason.
+  rejects_->Count(std::string(what) == "scan" ? "scan_time_jump" : "time_jump_unconfirmed", 1,
                   how + ": refused (believed only if the next message confirms it)");
   return TimeCheck::kOutlier;
 }
@@ -103,9 +159,11 @@ ScanSequencer::TimeCheck ScanSequencer::CheckTime(std::int64_t utime, const char
 ScanSequencer::Admission ScanSequencer::AddPose(const EgoPose& pose) {
   ++poses_received_;
   Admission a;
-  if (!pose.world_from_body.matrix().allFinite() || !IsRotation(pose.world_from_body.linear())) {
+  if (!pose.world_from_body.matrix().allFinite() || !IsRotation(pose.world_from_body.linear()) ||
+      pose.world_from_body.translation().cwiseAbs().maxCoeff() > kMaxPoseCoordinate) {
     rejects_->Count("invalid_pose", 1,
-                    "pose at " + Str(pose.utime) + " is not finite or not a rotation");
+                    "pose at " + Str(pose.utime) +
+                        " is not finite, not a rotation or farther than 1e7 m from the origin");
     return a;
   }
   const TimeCheck tc = CheckTime(pose.utime, "pose");
@@ -121,22 +179,31 @@ ScanSequencer::Admission ScanSequencer::AddPose(const EgoPose& pose) {
                       "pose at " + Str(pose.utime) + " is older than " + Str(poses_.newest_utime()));
       return a;
   }
+  // Poses lost on the way (a full receive queue, a lost datagram): the pose stream has no seq,
+  // so they are inferred from its timing. Counted on accepted poses only (in time order).
+  if (const std::int64_t missing = pose_gaps_.Add(pose.utime); missing > 0) {
+    rejects_->Count("pose_gap", missing,
+                    Str(missing) + " poses missing before the pose at " + Str(pose.utime) +
+                        " (nominal period " + Str(pose_gaps_.period_us()) + " us)");
+  }
   a.accepted = true;
   return a;
 }
 
-void ScanSequencer::CountSeqGap(std::int64_t seq) {
-  // Scans lost on the way (LCM drops a datagram, or a fragmented message with a fragment
-  // missing, without a word) show as gaps in the sensor's seq: one count per missing scan.
-  if (have_seq_ && seq > last_seq_) {
-    const std::uint64_t gap = static_cast<std::uint64_t>(seq) - static_cast<std::uint64_t>(last_seq_) - 1;
+void ScanSequencer::CountSeqGap(std::int64_t seq, const char* reason, const char* what,
+                                std::int64_t* last, bool* have) {
+  // Messages lost on the way (LCM drops a datagram, or a fragmented message with a fragment
+  // missing, or a full receive queue, without a word) show as gaps in the sensor's seq: one
+  // count per missing message.
+  if (*have && seq > *last) {
+    const std::uint64_t gap = static_cast<std::uint64_t>(seq) - static_cast<std::uint64_t>(*last) - 1;
     if (gap > 0 && gap <= kMaxSeqGap) {
-      rejects_->Count("scan_seq_gap", static_cast<std::int64_t>(gap),
-                      Str(static_cast<std::int64_t>(gap)) + " scans missing before scan " + Str(seq));
+      rejects_->Count(reason, static_cast<std::int64_t>(gap),
+                      Str(static_cast<std::int64_t>(gap)) + " " + what + " missing before seq " + Str(seq));
     }
   }
-  if (!have_seq_ || seq > last_seq_) last_seq_ = seq;
-  have_seq_ = true;
+  if (!*have || seq > *last) *last = seq;
+  *have = true;
 }
 
 std::string ScanSequencer::CheckScan(const LadarScan& scan, const char** reason) const {
@@ -149,6 +216,11 @@ std::string ScanSequencer::CheckScan(const LadarScan& scan, const char** reason)
   }
   if (scan.sweep_duration_us < 0 || scan.sweep_duration_us > params_.max_sweep_duration_us) {
     return "sweep_duration_us " + Str(scan.sweep_duration_us) + " out of range";
+  }
+  if (scan.num_rings < 1) return "num_rings " + Str(scan.num_rings) + " < 1";
+  // 0: the sensor did not say (returns are then bounded by the absolute limit only).
+  if (!std::isfinite(scan.max_range) || scan.max_range < 0.0f) {
+    return "max_range " + std::to_string(scan.max_range) + " is not finite or negative";
   }
   if (!scan.body_from_sensor.matrix().allFinite()) return "mounting pose is not finite";
   if (!IsRotation(scan.body_from_sensor.linear())) return "mounting orientation is not a rotation";
@@ -165,7 +237,7 @@ std::string ScanSequencer::CheckScan(const LadarScan& scan, const char** reason)
 
 ScanSequencer::Admission ScanSequencer::AddScan(LadarScan&& scan) {
   ++scans_received_;
-  CountSeqGap(scan.seq);
+  CountSeqGap(scan.seq, "scan_seq_gap", "scans", &last_seq_, &have_seq_);
   Admission a;
   auto drop = [&](const char* reason, const std::string& msg) {
     ++scans_dropped_;
@@ -199,6 +271,8 @@ ScanSequencer::Admission ScanSequencer::AddScan(LadarScan&& scan) {
 
 ScanSequencer::Admission ScanSequencer::AddDetections(DetectionList&& list) {
   ++detections_received_;
+  CountSeqGap(list.seq, "detections_seq_gap", "detection lists", &last_detections_seq_,
+              &have_detections_seq_);
   Admission a;
   for (const Detection& d : list.boxes) {
     const bool finite = std::isfinite(d.x) && std::isfinite(d.y) && std::isfinite(d.z) &&

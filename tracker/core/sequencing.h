@@ -6,7 +6,9 @@
 //
 // Bad input is refused and counted by reason (RejectCounter): malformed scans and poses, scans
 // out of time order or repeated, scans lost on the way (gaps in the sensor's seq), a full
-// queue. A message more than time_jump_reset_us older than the newest one (a looped log), or
+// queue, poses lost on the way (gaps in their timing). Every scan that is received and not
+// processed is counted under exactly one scan reason (see tracker/README.md), so that
+// scans_dropped equals their sum. A message more than time_jump_reset_us older than the newest one (a looped log), or
 // newer than the newest by more than any track may coast, is refused ("time_jump_unconfirmed")
 // unless the message before it made the same jump: two in a row reset the input (queue and
 // poses cleared, the caller clears its tracks) and the second is taken. One stray message
@@ -50,6 +52,34 @@ class RejectCounter {
   std::vector<TrackerEvent> events_;
 };
 
+// Messages lost on the way from a stream without a sequence number (the ego poses), inferred
+// from its timing: an interval longer than kGapFactor nominal periods means
+// round(interval / period) - 1 messages missing. The nominal period is estimated from the stream
+// itself from its last kWindow intervals (once kMinIntervals are known): the mean of those within
+// half a median of their median. Robust to the gaps themselves and to jitter, precise enough
+// for long gaps, and it follows a source that changes its rate (once most intervals have).
+class StreamGapCounter {
+ public:
+  // A gap longer than this many periods counts: a late message (jitter up to half a period)
+  // never does, one message missing (two periods) always does.
+  static constexpr double kGapFactor = 1.5;
+  // Intervals kept: the error of their mean (sigma / sqrt(kWindow) of the interval jitter, under
+  // 1 % of the period at +-15 % jitter per stamp) stays under half a period over a gap of 50
+  // periods; the estimate follows a change of rate after ~50 messages.
+  static constexpr std::size_t kWindow = 101;
+  static constexpr std::size_t kMinIntervals = 5;  // before any gap is counted
+  // The message at utime (times increasing); returns the number missing before it.
+  std::int64_t Add(std::int64_t utime);
+  void Clear();
+  // [us] the nominal period now (0 until kMinIntervals are known).
+  std::int64_t period_us() const;
+
+ private:
+  std::deque<std::int64_t> intervals_;
+  std::int64_t last_utime_ = 0;
+  bool have_last_ = false;
+};
+
 class ScanSequencer {
  public:
   // max_coast_us: the longest any track may coast; a jump forward beyond it (and beyond
@@ -87,8 +117,10 @@ class ScanSequencer {
   std::int64_t detections_processed() const { return detections_processed_; }
 
  private:
-  // Counts a gap in the sensor's scan seq as scans lost on the way.
-  void CountSeqGap(std::int64_t seq);
+  // Counts a gap in a sensor's seq (scans, detection lists) as messages lost on the way, under
+  // reason; *last / *have: the newest seq of that stream.
+  void CountSeqGap(std::int64_t seq, const char* reason, const char* what, std::int64_t* last,
+                   bool* have);
   // "" if the scan is well formed, else why not (its reject reason in *reason).
   std::string CheckScan(const LadarScan& scan, const char** reason) const;
   // Follows the newest message time: kOk, kReset (a jump confirmed: the input was reset), or
@@ -115,6 +147,9 @@ class ScanSequencer {
   bool have_scan_ = false;
   std::int64_t last_seq_ = 0;  // newest scan seq received (for scan_seq_gap)
   bool have_seq_ = false;
+  std::int64_t last_detections_seq_ = 0;  // newest detection list seq (detections_seq_gap)
+  bool have_detections_seq_ = false;
+  StreamGapCounter pose_gaps_;  // poses lost on the way (pose_gap)
   std::int64_t scans_received_ = 0, scans_processed_ = 0, scans_dropped_ = 0;
   std::int64_t poses_received_ = 0, resets_ = 0;
 };

@@ -117,7 +117,10 @@ bool Tracker::ProcessDetections(const DetectionList& list, bool extrapolate, Sca
   const std::optional<Eigen::Isometry3d> pose = sequencer_.poses().At(
       list.utime, extrapolate ? params_.input.max_extrapolation_us : 0, &status);
   if (!pose) {
-    rejects_.Count(status == PoseHistory::LookupStatus::kTooFarAhead ? "stale_pose" : "pose_missing", 1,
+    // Reasons of their own: the scan reasons must count scans only (their sum is scans_dropped).
+    rejects_.Count(status == PoseHistory::LookupStatus::kTooFarAhead ? "detections_stale_pose"
+                                                                     : "detections_pose_missing",
+                   1,
                    "detections " + Str(list.seq) + " at " + Str(list.utime) + ": no pose");
     return false;
   }
@@ -183,6 +186,11 @@ bool Tracker::Preprocess(const LadarScan& scan, bool extrapolate, PreprocessResu
   }
   rejects_.Count("nan_point", pre->stats.nonfinite,
                  at + ": " + Str(pre->stats.nonfinite) + " NaN/Inf returns dropped");
+  rejects_.Count("far_point", pre->stats.far,
+                 at + ": " + Str(pre->stats.far) +
+                     " returns beyond the sensor's max_range or the absolute bound dropped");
+  rejects_.Count("bad_ring", pre->stats.bad_ring,
+                 at + ": " + Str(pre->stats.bad_ring) + " returns with a ring outside [0, num_rings) dropped");
   rejects_.Count("bad_point_time", pre->stats.bad_time,
                  at + ": " + Str(pre->stats.bad_time) + " returns with dt_us outside the sweep dropped");
   return true;

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <random>
 #include <set>
 
 #include "tests/tracker/core/synthetic_scene.h"
@@ -292,7 +293,8 @@ TEST(TrackerTest, OneMessageOutOfTimeDoesNotResetTwoInARowDo) {
   tracker.AddScan(scene.ScanAt(-3.0, seq++), &out);  // 5 s behind the newest message
   run(2.01, 3.0);
   EXPECT_EQ(tracker.resets(), 0);
-  EXPECT_EQ(tracker.rejects().at("time_jump_unconfirmed"), 2);
+  EXPECT_EQ(tracker.rejects().at("time_jump_unconfirmed"), 1);  // the pose
+  EXPECT_EQ(tracker.rejects().at("scan_time_jump"), 1);         // the scan (a scan reason)
   EXPECT_EQ(confirmed_ids(), before);
   EXPECT_EQ(tracker.scans_received(),
             tracker.scans_processed() + tracker.scans_dropped() +
@@ -347,6 +349,47 @@ TEST(TrackerTest, InvalidParamsNameTheKey) {
   p.input.max_queued_scans = 0;
   EXPECT_FALSE(p.Validate(&error));
   EXPECT_NE(error.find("max_queued_scans"), std::string::npos) << error;
+}
+
+}  // namespace
+}  // namespace vtrack
+
+namespace vtrack {
+namespace {
+
+// Poses lost from a jittered 100 Hz stream (seeded): the counter infers exactly the poses left
+// out, from the timing alone, and nothing from jitter; it follows a change of rate.
+TEST(StreamGapCounterTest, CountsTheMessagesLeftOutOfAJitteredStream) {
+  std::mt19937_64 rng(20240611);
+  // [us] each stamp +-15 % of the period off its slot (intervals 70 to 130 % of the period)
+  std::uniform_int_distribution<int> jitter(-1500, 1500);
+  std::bernoulli_distribution lose(0.05);
+  StreamGapCounter gaps;
+  std::int64_t left_out = 0, counted = 0;
+  const std::int64_t t0 = 1'700'000'000'000'000;
+  for (int k = 0; k < 5000; ++k) {
+    // Never in the first 20 (the period is not known yet); a burst of 25 at 3000.
+    const bool lost = k >= 20 && (lose(rng) || (k >= 3000 && k < 3025));
+    const std::int64_t t = t0 + k * 10'000 + jitter(rng);
+    if (lost) {
+      ++left_out;
+      continue;
+    }
+    counted += gaps.Add(t);
+  }
+  EXPECT_GT(left_out, 200);
+  EXPECT_EQ(counted, left_out);
+  EXPECT_NEAR(static_cast<double>(gaps.period_us()), 10'000.0, 2'000.0);
+  // The source slows to 50 Hz: once the median has followed, nothing more is counted.
+  std::int64_t t = t0 + 5000 * 10'000;
+  std::int64_t after = 0;
+  for (int k = 0; k < 300; ++k) {
+    t += 20'000;
+    const std::int64_t n = gaps.Add(t);
+    if (k >= static_cast<int>(StreamGapCounter::kWindow)) after += n;
+  }
+  EXPECT_EQ(after, 0);
+  EXPECT_EQ(gaps.period_us(), 20'000);
 }
 
 }  // namespace

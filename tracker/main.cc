@@ -16,6 +16,7 @@
 #include <memory>
 #include <string>
 
+#include "lcmtypes/util/command_line.h"
 #include "lcmtypes/util/log_reader.h"
 #include "lcmtypes/util/process.h"
 #include "tracker/config.h"
@@ -40,6 +41,22 @@ std::string WithReceiveBuffer(std::string url) {
   return url + (url.find('?') == std::string::npos ? "?" : "&") + "recv_buf_size=4194304";
 }
 
+// LCM queues at most 30 messages per subscription (LCM's default) between its receive thread and
+// handle(): beyond that it drops them without a word. A tracker stalled for a moment (a slow
+// scan, a descheduled process, SIGSTOP) finds on resuming everything the socket buffer held, and
+// the receive thread reads it faster than the tracker handles it: at 100 Hz 30 poses are 0.3 s.
+// The queues are sized for a stall of kStallToAbsorbS at the highest rate expected on each
+// channel; what is lost anyway is counted (scan_seq_gap, pose_gap, detections_seq_gap).
+constexpr double kStallToAbsorbS = 5.0;  // [s]
+// Poses: 200 Hz (an INS; vtrack-ego-pose sends 100) x 5 s; a pose_t is 200 bytes, so 1000 cost
+// 0.2 MB at most.
+constexpr int kPoseQueue = 1000;
+// Scans and detection lists: 10 Hz x 5 s. Memory bound: 50 x 2.8 MB (a 64-layer sweep) = 140 MB,
+// reached only if the tracker falls 5 s behind; a single-plane sweep is ~10 KB. The core holds
+// at most input.max_queued_scans (50) as well.
+constexpr int kScanQueue = 50;
+static_assert(kPoseQueue >= 200 * kStallToAbsorbS && kScanQueue >= 10 * kStallToAbsorbS);
+
 class LiveHandler {
  public:
   explicit LiveHandler(TrackerNode* node) : node_(node) {}
@@ -62,10 +79,11 @@ int RunLive(const TrackerParams& params, NodeOptions options, const std::string&
                      lcm->publish(ch, data, static_cast<unsigned int>(size));
                    });
   LiveHandler handler(&node);
-  lcm->subscribe(options.scan_channel, &LiveHandler::OnMessage, &handler);
-  lcm->subscribe(options.pose_channel, &LiveHandler::OnMessage, &handler);
+  lcm->subscribe(options.scan_channel, &LiveHandler::OnMessage, &handler)->setQueueCapacity(kScanQueue);
+  lcm->subscribe(options.pose_channel, &LiveHandler::OnMessage, &handler)->setQueueCapacity(kPoseQueue);
   if (params.detections.mode != InputMode::kScans) {
-    lcm->subscribe(options.detections_channel, &LiveHandler::OnMessage, &handler);
+    lcm->subscribe(options.detections_channel, &LiveHandler::OnMessage, &handler)
+        ->setQueueCapacity(kScanQueue);
   }
   std::fprintf(stderr, "vtrack-tracker: live on %s, mode %s, %s + %s -> %s%s\n", url.c_str(),
                ToString(params.manager.mode), options.scan_channel.c_str(),
@@ -189,8 +207,16 @@ int main(int argc, char** argv) {
       ("quiet,q", "no progress output (offline)");
   po::variables_map vm;
   try {
-    po::store(po::parse_command_line(argc, argv, desc), vm);
+    const po::parsed_options parsed = po::parse_command_line(argc, argv, desc);
+    po::store(parsed, vm);
     po::notify(vm);
+    // Every argument is an option: a stray one (a log file without --input) would otherwise be
+    // ignored and the tracker would go live instead.
+    if (!vm.count("help")) lcm_util::RefuseStrayArguments(parsed);
+    for (const char* key : {"scan-channel", "pose-channel", "detections-channel", "tracks-channel",
+                            "debug-channel", "status-channel"}) {
+      lcm_util::RefuseEmpty(vm, key);
+    }
   } catch (const po::error& e) {
     std::cerr << "vtrack-tracker: " << e.what() << "\n(see --help)\n";
     return 2;

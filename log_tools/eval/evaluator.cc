@@ -133,12 +133,13 @@ std::optional<Eigen::Vector2d> TruthAt(const std::map<std::int64_t, vtrack::obje
   return Eigen::Vector2d((1 - s) * a->x + s * b->x, (1 - s) * a->y + s * b->y);
 }
 
-// True if an object or track of a frame can be scored: its position is finite and its id is new
-// in the frame (ids holds those seen). Otherwise counts "<kind>_not_finite" or
-// "<kind>_duplicate_id" in *problems and returns false.
-bool Admit(double x, double y, std::int64_t id, const std::string& kind,
+// True if an object or track of a frame can be scored: its position and heading are finite (a
+// NaN would poison every error sum it entered) and its id is new in the frame (ids holds those
+// seen). Otherwise counts "<kind>_not_finite" or "<kind>_duplicate_id" in *problems (printed in
+// the report's "input problem" lines and its JSON "problems") and returns false.
+bool Admit(double x, double y, double heading, std::int64_t id, const std::string& kind,
            std::set<std::int64_t>* ids, std::map<std::string, std::int64_t>* problems) {
-  if (!std::isfinite(x) || !std::isfinite(y)) {
+  if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(heading)) {
     ++(*problems)[kind + "_not_finite"];
     return false;
   }
@@ -392,7 +393,7 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params) {
     std::vector<bool> truth_scored;
     std::set<std::int64_t> truth_ids;
     for (const auto& o : gt.objects) {
-      if (!Admit(o.x, o.y, o.id, "truth", &truth_ids, &s.problems)) continue;
+      if (!Admit(o.x, o.y, o.yaw, o.id, "truth", &truth_ids, &s.problems)) continue;
       const bool is_scored =
           o.in_labelled_region && IsVehicleClass(o.object_class) &&
           in_region(o.x, o.y,
@@ -415,7 +416,7 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params) {
       const bool status_ok = tr.status == vtrack::track_t::STATUS_CONFIRMED ||
                              (params.score_coasting && tr.status == vtrack::track_t::STATUS_COASTING);
       if (!status_ok || tr.object_class != vtrack::track_t::CLASS_VEHICLE) continue;
-      if (!Admit(tr.x, tr.y, tr.id, "track", &track_ids, &s.problems)) continue;
+      if (!Admit(tr.x, tr.y, tr.theta, tr.id, "track", &track_ids, &s.problems)) continue;
       candidates.push_back(&tr);
       candidate_pose.push_back(Advance(tr, dt));
     }

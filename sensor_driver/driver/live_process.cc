@@ -4,6 +4,7 @@
 #include <exception>
 #include <stdexcept>
 
+#include "lcmtypes/util/command_line.h"
 #include "lcmtypes/util/process.h"
 
 namespace vtrack::sim {
@@ -40,6 +41,10 @@ std::optional<int> ParseLiveCommandLine(int argc, char** argv, const po::options
     }
     if (given.count("poses") && given.count("oxts")) {
       throw po::error("give at most one of --poses and --oxts");
+    }
+    CheckRealtimeOptions(given);
+    for (const char* key : {"scan-channel", "truth-channel", "channel"}) {
+      lcm_util::RefuseEmpty(given, key);
     }
   };
   return ParseSimCommandLine(argc, argv, desc, usage, name, check, vm, cli);

@@ -1,6 +1,8 @@
 #include "sensor_driver/driver/sim_cli.h"
 
+#include <cmath>
 #include <cstdio>
+#include <type_traits>
 
 #include "lcmtypes/util/command_line.h"
 
@@ -47,6 +49,21 @@ void AddRealtimeOptions(po::options_description* desc) {
        "vtrack-ego-pose the same");
 }
 
+void CheckRealtimeOptions(const po::variables_map& vm) {
+  // --stop-after inf would publish nothing and exit 0, nan would never stop: refused.
+  const double stop_after = vm["stop-after"].as<double>();
+  if (!std::isfinite(stop_after) || stop_after < 0) {
+    throw po::error("--stop-after = " + std::to_string(stop_after) + ": must be finite and >= 0");
+  }
+  const double rate = vm["rate"].as<double>();
+  if (!std::isfinite(rate) || !(rate > 0)) {
+    throw po::error("--rate = " + std::to_string(rate) + ": must be finite and > 0");
+  }
+  if (vm["laps"].as<std::int64_t>() < 0) {
+    throw po::error("--laps = " + std::to_string(vm["laps"].as<std::int64_t>()) + ": must be >= 0");
+  }
+}
+
 void ReadRealtimeOptions(const po::variables_map& vm, const SimCli& cli, RealtimeOptions* o) {
   o->start_utime = cli.start_utime;
   o->laps = vm["laps"].as<std::int64_t>();
@@ -57,7 +74,17 @@ void ReadRealtimeOptions(const po::variables_map& vm, const SimCli& cli, Realtim
 SimCli ReadSimCli(const po::variables_map& vm) {
   SimCli c;
   auto get = [&](const char* k, auto* out) {
-    if (vm.count(k)) *out = vm[k].as<std::remove_reference_t<decltype(**out)>>();
+    if (!vm.count(k)) return;
+    using T = std::remove_reference_t<decltype(**out)>;
+    const T v = vm[k].as<T>();
+    if constexpr (std::is_floating_point_v<T>) {
+      // Every numeric option of the simulator is a size, a rate or a probability: NaN, Inf or
+      // a negative value is a mistake, never a request.
+      if (!std::isfinite(v) || v < 0) {
+        throw po::error(std::string("--") + k + " = " + std::to_string(v) + ": must be finite and >= 0");
+      }
+    }
+    *out = v;
   };
   if (vm.count("scenario")) c.scenario = vm["scenario"].as<std::string>();
   get("duration", &c.duration);

@@ -32,6 +32,8 @@ void AddPoseOptions(boost::program_options::options_description* desc);
 // --laps, --stop-after, --rate: the schedule of the two live processes (realtime.h).
 void AddRealtimeOptions(boost::program_options::options_description* desc);
 // Fills options->laps, stop_after_s, rate and start_utime from vm and cli; the rest is left.
+// Throws po::error if --stop-after, --rate or --laps is out of range (non-finite, negative).
+void CheckRealtimeOptions(const boost::program_options::variables_map& vm);
 void ReadRealtimeOptions(const boost::program_options::variables_map& vm, const SimCli& cli,
                          RealtimeOptions* options);
 

@@ -8,6 +8,10 @@
 
 #include "lcmtypes/util/log_reader.h"
 #include "log_tools/eval/evaluator.h"
+#include "log_tools/eval/report.h"
+#include "lcmtypes/util/decode.h"
+#include "vtrack/object_list_t.hpp"
+#include "vtrack/track_list_t.hpp"
 #include "vtrack/ladar_scan_t.hpp"
 #include "tests/log_tools/synthetic_run.h"
 #include "tests/support/test_env.h"
@@ -169,6 +173,74 @@ TEST_F(EvaluatorTest, ModesAndDuplicates) {
     FAIL() << "conflicting track lists accepted";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("tracks_changed.lcm"), std::string::npos) << e.what();
+  }
+}
+
+// Input the evaluator cannot score: tracks with a NaN position or heading, ground truth with a
+// NaN position and an object listed twice under one id. Each is refused, counted under its
+// problem, printed in the report, and the scores are those of the clean input.
+TEST_F(EvaluatorTest, NonFiniteAndDuplicateInputIsRefusedCountedAndPrinted) {
+  const std::string run = dir_ + "/run_bad.lcm", tracks = dir_ + "/tracks_bad.lcm";
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  int truth_nan = 0, truth_dup = 0, track_nan = 0;
+  {
+    lcm_util::LogReader in(run_);
+    lcm_util::LogWriter out(run);
+    while (const lcm::LogEvent* ev = in.Next()) {
+      vtrack::object_list_t m;
+      if (ev->channel != "GROUND_TRUTH" || m.decode(ev->data, 0, ev->datalen) < 0 || m.objects.empty()) {
+        out.Write(ev->timestamp, ev->channel, ev->data, static_cast<std::size_t>(ev->datalen));
+        continue;
+      }
+      m.objects.push_back(m.objects.front());  // the same object again, same id
+      ++truth_dup;
+      vtrack::object_t bad = m.objects.front();
+      bad.id = 9000;
+      bad.x = nan;
+      m.objects.push_back(bad);
+      ++truth_nan;
+      m.num_objects = static_cast<std::int32_t>(m.objects.size());
+      out.WriteMessage(ev->timestamp, ev->channel, m);
+    }
+  }
+  {
+    lcm_util::LogWriter out(tracks);
+    for (vtrack::track_list_t l : vtrack::testing::SyntheticTracks("mht")) {
+      for (const vtrack::track_t& t : std::vector<vtrack::track_t>(l.tracks)) {
+        if (t.status != vtrack::track_t::STATUS_CONFIRMED ||
+            t.object_class != vtrack::track_t::CLASS_VEHICLE) {
+          continue;
+        }
+        vtrack::track_t a = t, b = t;
+        a.id = t.id + 1000;
+        a.y = nan;
+        b.id = t.id + 2000;
+        b.theta = nan;
+        l.tracks.push_back(a);
+        l.tracks.push_back(b);
+        track_nan += 2;
+        break;
+      }
+      l.num_tracks = static_cast<std::int32_t>(l.tracks.size());
+      out.WriteMessage(l.utime, "TRACKS", l);
+    }
+  }
+  ASSERT_GT(track_nan, 0);
+  const EvalParams params;
+  const EvalSummary clean = Evaluate(LoadLogs({run_, tracks_}, params), params);
+  const EvalSummary s = Evaluate(LoadLogs({run, tracks}, params), params);
+  EXPECT_EQ(s.problems.at("truth_not_finite"), truth_nan);
+  EXPECT_EQ(s.problems.at("truth_duplicate_id"), truth_dup);
+  EXPECT_EQ(s.problems.at("track_not_finite"), track_nan);
+  EXPECT_EQ(s.clear.true_positives, clean.clear.true_positives);
+  EXPECT_EQ(s.clear.false_positives, clean.clear.false_positives);
+  EXPECT_EQ(s.clear.false_negatives, clean.clear.false_negatives);
+  EXPECT_DOUBLE_EQ(s.position_rmse_m, clean.position_rmse_m);
+  EXPECT_DOUBLE_EQ(s.heading_rmse_deg, clean.heading_rmse_deg);
+  const std::string text = SummaryText(s);
+  for (const char* k : {"truth_not_finite", "truth_duplicate_id", "track_not_finite"}) {
+    EXPECT_NE(text.find(std::string("input problem: ") + k), std::string::npos) << k << "\n" << text;
+    EXPECT_NE(SummaryJson(s).find(k), std::string::npos) << k;
   }
 }
 

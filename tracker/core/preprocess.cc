@@ -100,6 +100,66 @@ bool Preprocessor::ComputeKnots(const LadarScan& scan, const PoseHistory& poses,
   return true;
 }
 
+namespace {
+
+// Which returns of a scan are kept, and why the others are not.
+struct ReturnFilter {
+  double min_r2 = 0, max_r2 = 0;  // [m^2] the tracker's own range limits (out_of_range)
+  double far_r2 = 0;              // [m^2] beyond what the sensor can measure (far)
+  int num_rings = 1;
+  bool has_ring = false;
+  bool has_dt = false;
+  std::int64_t sweep = 0;         // [us]
+
+  ReturnFilter(const LadarScan& scan, const PreprocessParams& params) {
+    const std::size_t n = scan.size();
+    min_r2 = params.min_range * params.min_range;
+    max_r2 = params.max_range * params.max_range;
+    // Returns a sensor cannot have measured (finite but absurd: 3e38 m) are refused and counted,
+    // apart from the tracker's own range limits: beyond the sensor's stated max_range (1 % margin
+    // for the rounding of coordinates sent as floats), or beyond kMaxReturnRange if it stated
+    // none (0).
+    const double sensor_max = scan.max_range > 0.0f
+                                  ? std::min<double>(kMaxReturnRange, 1.01 * scan.max_range)
+                                  : kMaxReturnRange;
+    far_r2 = sensor_max * sensor_max;
+    num_rings = scan.num_rings;
+    has_ring = scan.ring.size() == n;
+    has_dt = scan.dt_us.size() == n;
+    sweep = std::max<std::int64_t>(0, scan.sweep_duration_us);
+  }
+
+  // True if return i is kept (its time after utime in *dt), else counts why not in *stats.
+  bool Keep(const LadarScan& scan, std::size_t i, PreprocessStats* stats, std::int64_t* dt) const {
+    const double px = scan.x[i], py = scan.y[i], pz = scan.z[i];
+    if (!std::isfinite(px) || !std::isfinite(py) || !std::isfinite(pz)) {
+      ++stats->nonfinite;
+      return false;
+    }
+    const double r2 = px * px + py * py + pz * pz;
+    if (r2 > far_r2) {
+      ++stats->far;
+      return false;
+    }
+    if (has_ring && (scan.ring[i] < 0 || scan.ring[i] >= num_rings)) {
+      ++stats->bad_ring;
+      return false;
+    }
+    if (r2 < min_r2 || r2 > max_r2) {
+      ++stats->out_of_range;
+      return false;
+    }
+    *dt = has_dt ? scan.dt_us[i] : 0;
+    if (*dt < 0 || *dt > sweep) {
+      ++stats->bad_time;
+      return false;
+    }
+    return true;
+  }
+};
+
+}  // namespace
+
 void Preprocessor::Compensate(const LadarScan& scan, PreprocessStats* stats, WorldPoints* out) {
   const std::size_t n = scan.size();
   const std::int64_t sweep = std::max<std::int64_t>(0, scan.sweep_duration_us);
@@ -107,17 +167,8 @@ void Preprocessor::Compensate(const LadarScan& scan, PreprocessStats* stats, Wor
   const std::int64_t num_intervals = static_cast<std::int64_t>(knot_d_.size());
   // Body-frame height of a return: the z row of body_from_sensor (the mounting is rigid).
   const Eigen::Matrix<double, 1, 4> body_z = scan.body_from_sensor.matrix().row(2);
-  const double min_r2 = params_.min_range * params_.min_range;
-  const double max_r2 = params_.max_range * params_.max_range;
-  const bool has_ring = scan.ring.size() == n;
-  // Returns a sensor cannot have measured (finite but absurd: 3e38 m) are refused and counted,
-  // apart from the tracker's own range limits: beyond the sensor's stated max_range (1 % margin
-  // for the rounding of coordinates sent as floats), or beyond kMaxReturnRange if it stated none.
-  const double sensor_max = scan.max_range > 0.0f ? std::min<double>(kMaxReturnRange, 1.01 * scan.max_range)
-                                                  : kMaxReturnRange;
-  const double far_r2 = sensor_max * sensor_max;
-  const int num_rings = scan.num_rings;
-  const bool has_dt = scan.dt_us.size() == n;
+  const ReturnFilter filter(scan, params_);
+  const bool has_ring = filter.has_ring;
   const double inv_step = 1.0 / static_cast<double>(step);
   if (fraction_.size() != static_cast<std::size_t>(step) + 1) {
     fraction_.resize(static_cast<std::size_t>(step) + 1);
@@ -140,29 +191,9 @@ void Preprocessor::Compensate(const LadarScan& scan, PreprocessStats* stats, Wor
   std::int16_t* const orng = out->ring.data();
   std::size_t w = 0;
   for (std::size_t i = 0; i < n; ++i) {
+    std::int64_t dt = 0;
+    if (!filter.Keep(scan, i, stats, &dt)) continue;
     const double px = scan.x[i], py = scan.y[i], pz = scan.z[i];
-    if (!std::isfinite(px) || !std::isfinite(py) || !std::isfinite(pz)) {
-      ++stats->nonfinite;
-      continue;
-    }
-    const double r2 = px * px + py * py + pz * pz;
-    if (r2 > far_r2) {
-      ++stats->far;
-      continue;
-    }
-    if (has_ring && (scan.ring[i] < 0 || scan.ring[i] >= num_rings)) {
-      ++stats->bad_ring;
-      continue;
-    }
-    if (r2 < min_r2 || r2 > max_r2) {
-      ++stats->out_of_range;
-      continue;
-    }
-    const std::int64_t dt = has_dt ? scan.dt_us[i] : 0;
-    if (dt < 0 || dt > sweep) {
-      ++stats->bad_time;
-      continue;
-    }
     // dt / step without a 64-bit division per return: a floating-point guess, corrected to the
     // exact quotient.
     std::int64_t q = static_cast<std::int64_t>(static_cast<double>(dt) * inv_step);

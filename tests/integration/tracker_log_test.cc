@@ -331,5 +331,24 @@ TEST(TrackerCliTest, HelpAndBadOptions) {
                         "/tmp/vtrack-never.lcm"}), 1);
 }
 
+// An argument that is not an option (a log given without --input) would be ignored and the
+// tracker would go live: refused, naming it. So is an empty channel name.
+TEST(TrackerCliTest, StrayArgumentsAndEmptyChannelsAreRefused) {
+  const std::string dir = ScratchDir("tracker_cli");
+  const std::string out = dir + "/out.txt";
+  EXPECT_EQ(RunCommand({Bin("vtrack-tracker"), "run.lcm"}, out, std::chrono::seconds(30)), 2);
+  EXPECT_NE(ReadFile(out).find("unexpected argument 'run.lcm'"), std::string::npos) << ReadFile(out);
+  EXPECT_EQ(RunCommand({Bin("vtrack-tracker"), "--input", "/dev/null", "--output", dir + "/o.lcm",
+                        "extra"}, out, std::chrono::seconds(30)), 2);
+  EXPECT_NE(ReadFile(out).find("'extra'"), std::string::npos) << ReadFile(out);
+  for (const char* opt : {"--scan-channel", "--pose-channel", "--detections-channel",
+                          "--tracks-channel", "--debug-channel", "--status-channel"}) {
+    EXPECT_EQ(RunCommand({Bin("vtrack-tracker"), opt, "", "--input", "/dev/null", "--output",
+                          dir + "/o.lcm"}, out, std::chrono::seconds(30)), 2) << opt;
+    EXPECT_NE(ReadFile(out).find(std::string(opt) + " must not be empty"), std::string::npos)
+        << ReadFile(out);
+  }
+}
+
 }  // namespace
 }  // namespace vtrack::testing

@@ -182,7 +182,7 @@ TEST_F(EvaluatorTest, ModesAndDuplicates) {
 TEST_F(EvaluatorTest, NonFiniteAndDuplicateInputIsRefusedCountedAndPrinted) {
   const std::string run = dir_ + "/run_bad.lcm", tracks = dir_ + "/tracks_bad.lcm";
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  int truth_nan = 0, truth_dup = 0, track_nan = 0;
+  int truth_nan = 0, track_nan = 0;
   {
     lcm_util::LogReader in(run_);
     lcm_util::LogWriter out(run);
@@ -193,7 +193,6 @@ TEST_F(EvaluatorTest, NonFiniteAndDuplicateInputIsRefusedCountedAndPrinted) {
         continue;
       }
       m.objects.push_back(m.objects.front());  // the same object again, same id
-      ++truth_dup;
       vtrack::object_t bad = m.objects.front();
       bad.id = 9000;
       bad.x = nan;
@@ -229,9 +228,14 @@ TEST_F(EvaluatorTest, NonFiniteAndDuplicateInputIsRefusedCountedAndPrinted) {
   const EvalParams params;
   const EvalSummary clean = Evaluate(LoadLogs({run_, tracks_}, params), params);
   const EvalSummary s = Evaluate(LoadLogs({run, tracks}, params), params);
-  EXPECT_EQ(s.problems.at("truth_not_finite"), truth_nan);
-  EXPECT_EQ(s.problems.at("truth_duplicate_id"), truth_dup);
-  EXPECT_EQ(s.problems.at("track_not_finite"), track_nan);
+  // Frames are scored where truth and tracks meet: kScans of them (the truth at -1 s has no
+  // tracks, the tracks at +100 s no truth), one bad truth object of each kind and two bad tracks
+  // in each.
+  ASSERT_EQ(truth_nan, kScans + 1);
+  ASSERT_EQ(track_nan, 2 * (kScans + 1));
+  EXPECT_EQ(s.problems.at("truth_not_finite"), kScans);
+  EXPECT_EQ(s.problems.at("truth_duplicate_id"), kScans);
+  EXPECT_EQ(s.problems.at("track_not_finite"), 2 * kScans);
   EXPECT_EQ(s.clear.true_positives, clean.clear.true_positives);
   EXPECT_EQ(s.clear.false_positives, clean.clear.false_positives);
   EXPECT_EQ(s.clear.false_negatives, clean.clear.false_negatives);

@@ -139,6 +139,11 @@ TEST(MonitorCliTest, SummarisesALog) {
   EXPECT_EQ(vtrack::testing::RunCommand({exe, "--interval", "0"}, out), 2);
   EXPECT_NE(vtrack::testing::ReadFile(out).find("--interval must be > 0"), std::string::npos);
   EXPECT_EQ(vtrack::testing::RunCommand({exe, "--input", dir + "/none.lcm"}, out), 1);
+  // A log named without --input would be ignored and the monitor would go live: refused.
+  EXPECT_EQ(vtrack::testing::RunCommand({exe, dir + "/run.lcm"}, out, std::chrono::seconds(30)), 2);
+  EXPECT_NE(vtrack::testing::ReadFile(out).find("unexpected argument '" + dir + "/run.lcm'"),
+            std::string::npos)
+      << vtrack::testing::ReadFile(out);
   EXPECT_EQ(vtrack::testing::RunCommand({exe, "--help"}, out), 0);
 }
 

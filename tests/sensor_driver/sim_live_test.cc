@@ -180,6 +180,45 @@ TEST(SimLiveTest, BadRateIsRefused) {
   }
 }
 
+// --stop-after inf would publish nothing and exit 0, nan would never stop; NaN / negative model
+// numbers, stray arguments and empty channel names would be taken silently: all refused with
+// exit 2 and the option named, before anything is sent.
+TEST(SimLiveTest, NonFiniteNumbersStrayArgumentsAndEmptyChannelsAreRefused) {
+  const std::string dir = ScratchDir("sim_live_bad_options");
+  const std::string out = dir + "/out.txt";
+  for (const std::string bin : {"vtrack-ladar-driver", "vtrack-ego-pose"}) {
+    const std::vector<std::string> base = {BinDir() + "/" + bin, "--scenario", "paper_fig4_turn",
+                                           "--lcm-url", "memq://"};
+    auto run = [&](std::vector<std::string> extra, const std::string& said) {
+      std::vector<std::string> argv = base;
+      argv.insert(argv.end(), extra.begin(), extra.end());
+      EXPECT_EQ(RunCommand(argv, out, std::chrono::seconds(30)), 2) << bin << " " << extra.front();
+      EXPECT_NE(ReadFile(out).find(said), std::string::npos) << ReadFile(out);
+    };
+    for (const char* v : {"inf", "nan", "-1"}) run({"--stop-after", v}, "--stop-after");
+    run({"--rate", "inf", "--start-utime", "1"}, "--rate");
+    run({"--duration", "nan"}, "--duration");
+    run({"stray"}, "unexpected argument 'stray'");
+  }
+  auto refused = [&](const std::string& bin, std::vector<std::string> argv, const std::string& said) {
+    argv.insert(argv.begin(), BinDir() + "/" + bin);
+    EXPECT_EQ(RunCommand(argv, out, std::chrono::seconds(30)), 2) << bin << " " << argv.back();
+    EXPECT_NE(ReadFile(out).find(said), std::string::npos) << ReadFile(out);
+  };
+  const std::vector<std::string> scene = {"--scenario", "paper_fig4_turn", "--lcm-url", "memq://"};
+  auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> a = scene;
+    a.insert(a.end(), extra.begin(), extra.end());
+    return a;
+  };
+  refused("vtrack-ladar-driver", with({"--dropout", "nan"}), "--dropout");
+  refused("vtrack-ladar-driver", with({"--range-noise", "-0.1"}), "--range-noise");
+  refused("vtrack-ladar-driver", with({"--scan-channel", ""}), "--scan-channel must not be empty");
+  refused("vtrack-ladar-driver", with({"--truth-channel", ""}), "--truth-channel must not be empty");
+  refused("vtrack-ego-pose", with({"--channel", ""}), "--channel must not be empty");
+  refused("vtrack-ego-pose", with({"--pose-rate", "nan"}), "--pose-rate");
+}
+
 // No --start-utime: the ego-pose process and the driver, started 1.3 s apart, each join the lap in
 // progress on the wall-clock grid. Every scan's and every pose's content equals vtrack-sim-log's
 // for that lap (seq aside: live it counts on across laps).

@@ -45,6 +45,44 @@ std::vector<std::uint8_t> TrackerProgram(int mode, int rings, int flags_every) {
   return b;
 }
 
+// One event of an LCM log file (lcm-logger format): big-endian header of sync word, event number,
+// timestamp, channel and data lengths, then the channel and the data.
+void AppendEvent(std::vector<std::uint8_t>* log, std::int64_t eventnum, std::int64_t utime,
+                 const std::string& channel, const std::vector<std::uint8_t>& data) {
+  auto put = [&](std::uint64_t v, int n) {
+    for (int i = n - 1; i >= 0; --i) log->push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+  };
+  put(0xEDA1DA01u, 4);
+  put(static_cast<std::uint64_t>(eventnum), 8);
+  put(static_cast<std::uint64_t>(utime), 8);
+  put(channel.size(), 4);
+  put(data.size(), 4);
+  log->insert(log->end(), channel.begin(), channel.end());
+  log->insert(log->end(), data.begin(), data.end());
+}
+
+// Log-reader seeds: a small whole log of poses and a scan, and the kinds of damage the reader
+// skips (garbage between events, an impossible length, a cut last event, a lone sync word).
+void WriteLogSeeds(const std::filesystem::path& dir, vtrack::testing::RandomMessages* r) {
+  std::vector<std::uint8_t> whole;
+  std::int64_t n = 0;
+  for (int i = 0; i < 3; ++i) {
+    AppendEvent(&whole, n++, 1'700'000'000'000'000 + i * 10'000, "EGO_POSE", vtrack::testing::Encode(r->Pose()));
+  }
+  AppendEvent(&whole, n++, 1'700'000'000'030'000, "LADAR_SCAN", vtrack::testing::Encode(r->Scan(3)));
+  AppendEvent(&whole, n++, 1'700'000'000'040'000, "EMPTY", {});
+  WriteBytes(dir, "whole", whole);
+  std::vector<std::uint8_t> garbage = whole;
+  const std::uint8_t junk[] = {0xED, 0xA1, 0xDA, 0x01, 0x00, 0x13, 0x37, 0xff, 0xff};
+  garbage.insert(garbage.begin() + 40, junk, junk + sizeof(junk));
+  WriteBytes(dir, "garbage_between_events", garbage);
+  std::vector<std::uint8_t> inflated = whole;
+  inflated[24] = 0x7f;  // the first event's data length ~2^31
+  WriteBytes(dir, "impossible_length", inflated);
+  WriteBytes(dir, "cut_last_event", std::vector<std::uint8_t>(whole.begin(), whole.end() - 7));
+  WriteBytes(dir, "lone_sync_word", {0xED, 0xA1, 0xDA, 0x01});
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -63,6 +101,7 @@ int main(int argc, char** argv) {
     Write(out / "track_debug_t", n, r.Debug(i));
     Write(out / "tracker_status_t", n, r.Status());
   }
+  WriteLogSeeds(out / "log_reader", &r);
   WriteBytes(out / "tracker", "mht_plane", TrackerProgram(0, 1, 0));
   WriteBytes(out / "tracker", "ism_cloud", TrackerProgram(1, 16, 0));
   WriteBytes(out / "tracker", "vasm_plane", TrackerProgram(2, 1, 0));

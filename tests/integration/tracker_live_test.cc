@@ -8,9 +8,12 @@
 
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <memory>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -71,12 +74,17 @@ int CompareTracks(const std::map<std::int64_t, track_list_t>& a,
 struct LiveRun {
   std::string dir, live_log, sim_log, offline;
   std::int64_t start_utime = 0;
+  // With a kill: [us, wall clock] when the tracker was killed and when its successor started.
+  std::int64_t killed_utime = 0, restarted_utime = 0;
 };
 
 // Logger + tracker + driver + ego pose, one lap of the scenario; then the same lap offline.
 // The lap is published at `rate` data seconds per wall second (the processes' --rate): the
 // messages, and so the tracks, are the same at any pace; only how long the test waits changes.
-LiveRun RunLive(const std::string& scenario, double duration_s, double rate = 1.0) {
+// kill_tracker_after_s > 0: the tracker is killed (SIGKILL) that many seconds into the lap and
+// started again at once; both then take their ids from their start time, as in service.
+LiveRun RunLive(const std::string& scenario, double duration_s, double rate = 1.0,
+                double kill_tracker_after_s = 0.0) {
   if (rate != 1.0) std::printf("publishing at %.3f x real time\n", rate);
   LiveRun run;
   run.dir = ScratchDir("tracker_live_" + scenario);
@@ -88,7 +96,10 @@ LiveRun RunLive(const std::string& scenario, double duration_s, double rate = 1.
   {
     Subprocess logger({"lcm-logger", "-q", "-f", kLoggerUrl, run.live_log}, run.dir + "/logger.txt");
     // Ids from 1, as offline (live, they start from the start time): compared one to one below.
-    Subprocess tracker({Bin("vtrack-tracker"), "--first-track-id", "1"}, run.dir + "/tracker.txt");
+    const bool kill = kill_tracker_after_s > 0.0;
+    std::vector<std::string> tracker_argv = {Bin("vtrack-tracker")};
+    if (!kill) tracker_argv.insert(tracker_argv.end(), {"--first-track-id", "1"});
+    auto tracker = std::make_unique<Subprocess>(tracker_argv, run.dir + "/tracker.txt");
     std::this_thread::sleep_for(500ms);
     Subprocess ego({Bin("vtrack-ego-pose"), "--scenario", scenario, "--start-utime", u,
                     "--duration", d, "--laps", "1", "--rate", r, "-q"},
@@ -96,6 +107,16 @@ LiveRun RunLive(const std::string& scenario, double duration_s, double rate = 1.
     Subprocess driver({Bin("vtrack-ladar-driver"), "--scenario", scenario, "--start-utime", u,
                        "--duration", d, "--laps", "1", "--rate", r, "-q"},
                       run.dir + "/driver.txt");
+    if (kill) {
+      const std::int64_t at = run.start_utime + static_cast<std::int64_t>(kill_tracker_after_s / rate * 1e6);
+      std::this_thread::sleep_for(std::chrono::microseconds(std::max<std::int64_t>(0, at - lcm_util::WallUtime())));
+      run.killed_utime = lcm_util::WallUtime();
+      tracker->Signal(SIGKILL);
+      const auto rk = tracker->Wait(5s);
+      EXPECT_TRUE(rk && *rk == 128 + SIGKILL);
+      run.restarted_utime = lcm_util::WallUtime();
+      tracker = std::make_unique<Subprocess>(tracker_argv, run.dir + "/tracker_restarted.txt");
+    }
     const auto limit =
         std::chrono::milliseconds(static_cast<int>((3.0 + duration_s / rate + 30.0) * 1000));
     const auto rd = driver.Wait(limit);
@@ -103,7 +124,7 @@ LiveRun RunLive(const std::string& scenario, double duration_s, double rate = 1.
     EXPECT_TRUE(rd && *rd == 0) << ReadFile(run.dir + "/driver.txt");
     EXPECT_TRUE(re && *re == 0) << ReadFile(run.dir + "/ego.txt");
     std::this_thread::sleep_for(1s);
-    EXPECT_EQ(tracker.Stop(), 0) << ReadFile(run.dir + "/tracker.txt");
+    EXPECT_EQ(tracker->Stop(), 0) << ReadFile(run.dir + (kill ? "/tracker_restarted.txt" : "/tracker.txt"));
     std::this_thread::sleep_for(300ms);
     logger.Stop();
   }
@@ -145,6 +166,55 @@ TEST(TrackerLiveTest, Fig4TurnLiveEveryVehicleTrackedNoIdentitySwitchSameAsOffli
   // Fed live or from the log, the tracker gives the same ids and states (no message lost on the
   // loopback bus: the results are bit-identical; the tolerance allows for nothing else).
   EXPECT_GT(CompareTracks(TracksByUtime(run.live_log), TracksByUtime(run.offline), 1e-9), 390);
+}
+
+// kill -9 of the live tracker mid-lap, restarted at once: no id it gave before the kill appears
+// after it (the successor's ids start from its start time), and the successor has confirmed
+// vehicles again, as many as its predecessor last reported, within 1 s (message time) of its
+// first TRACKS. Told apart by the logger's receive time of each TRACKS message.
+TEST(TrackerLiveTest, KilledTrackerRestartsWithNewIdsAndItsTracksBackWithin1s) {
+  VTRACK_REQUIRE_PRIVATE_NETNS();
+  const LiveRun run = RunLive("paper_fig4_turn", 16.0, 1.0, 8.0);
+  ASSERT_GT(run.restarted_utime, run.killed_utime);
+  std::set<std::int64_t> before_ids;
+  int confirmed_before = 0, lists_before = 0, lists_after = 0;
+  std::int64_t first_after_utime = 0;
+  std::map<std::int64_t, int> confirmed_after;  // by message utime
+  int reused = 0;
+  lcm_util::LogReader reader(run.live_log);
+  while (const lcm::LogEvent* ev = reader.Next()) {
+    if (ev->channel != "TRACKS") continue;
+    track_list_t m;
+    ASSERT_EQ(lcm_util::Decode(ev->data, static_cast<std::size_t>(ev->datalen), &m),
+              lcm_util::DecodeError::kNone);
+    // Confirmed vehicles: what a consumer acts on (static clutter may take longer to confirm).
+    int confirmed = 0;
+    for (const track_t& t : m.tracks) {
+      confirmed += t.status == track_t::STATUS_CONFIRMED && t.object_class == track_t::CLASS_VEHICLE;
+    }
+    if (ev->timestamp < run.killed_utime) {
+      ++lists_before;
+      for (const track_t& t : m.tracks) before_ids.insert(t.id);
+      confirmed_before = confirmed;
+    } else if (ev->timestamp > run.restarted_utime) {
+      ++lists_after;
+      if (first_after_utime == 0) first_after_utime = m.utime;
+      for (const track_t& t : m.tracks) reused += before_ids.count(t.id) > 0;
+      confirmed_after[m.utime] = confirmed;
+    }
+  }
+  std::printf("before the kill: %d track lists, %zu ids, %d confirmed vehicles at the end; after: %d lists\n",
+              lists_before, before_ids.size(), confirmed_before, lists_after);
+  ASSERT_GT(lists_before, 100);  // 8 s at 25 Hz
+  ASSERT_GT(lists_after, 100);
+  ASSERT_GT(confirmed_before, 0);
+  EXPECT_EQ(reused, 0);
+  int back_within_1s = 0;
+  for (const auto& [utime, n] : confirmed_after) {
+    if (utime <= first_after_utime + 1'000'000) back_within_1s = std::max(back_within_1s, n);
+  }
+  std::printf("after the restart: %d confirmed vehicles within 1 s of its first TRACKS\n", back_within_1s);
+  EXPECT_GE(back_within_1s, confirmed_before);
 }
 
 TEST(TrackerLiveTest, UrbanIntersectionLiveWith64LayerScans) {

@@ -42,20 +42,22 @@ std::string WithReceiveBuffer(std::string url) {
 }
 
 // LCM queues at most 30 messages per subscription (LCM's default) between its receive thread and
-// handle(): beyond that it drops them without a word. A tracker stalled for a moment (a slow
+// handle(), and beyond that drops them without a word. A tracker stalled for a moment (a slow
 // scan, a descheduled process, SIGSTOP) finds on resuming everything the socket buffer held, and
 // the receive thread reads it faster than the tracker handles it: at 100 Hz 30 poses are 0.3 s.
 // The queues are sized for a stall of kStallToAbsorbS at the highest rate expected on each
-// channel; what is lost anyway is counted (scan_seq_gap, pose_gap, detections_seq_gap).
-constexpr double kStallToAbsorbS = 5.0;  // [s]
-// Poses: 200 Hz (an INS; vtrack-ego-pose sends 100) x 5 s; a pose_t is 200 bytes, so 1000 cost
-// 0.2 MB at most.
+// channel; whatever is lost anyway is counted (scan_seq_gap, pose_gap, detections_seq_gap).
+// kStallToAbsorbS: the longest any track coasts (manager.parked_coast_max_s): after a longer
+// stall every track has ended, and older input would only be processed to be discarded.
+constexpr double kStallToAbsorbS = 3.0;  // [s]
+// Poses: 3 s at 200 Hz (an INS; vtrack-ego-pose sends 100 Hz) = 600, with margin. A pose_t is
+// 200 bytes: 0.2 MB at most.
 constexpr int kPoseQueue = 1000;
-// Scans and detection lists: 10 Hz x 5 s. Memory bound: 50 x 2.8 MB (a 64-layer sweep) = 140 MB,
-// reached only if the tracker falls 5 s behind; a single-plane sweep is ~10 KB. The core holds
-// at most input.max_queued_scans (50) as well.
-constexpr int kScanQueue = 50;
-static_assert(kPoseQueue >= 200 * kStallToAbsorbS && kScanQueue >= 10 * kStallToAbsorbS);
+// Scans and detection lists: 3 s at 25 Hz (the fastest simulated sensor, a single-plane one of
+// ~10 KB per sweep) = 75, with margin. Memory bound: 3 s of 64-layer sweeps at 10 Hz are 30 x
+// 2.8 MB = 84 MB; the whole queue, 100 x 2.8 MB = 280 MB, only if the tracker fell 10 s behind.
+constexpr int kScanQueue = 100;
+static_assert(kPoseQueue >= 200 * kStallToAbsorbS && kScanQueue >= 25 * kStallToAbsorbS);
 
 class LiveHandler {
  public:

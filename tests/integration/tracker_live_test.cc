@@ -81,10 +81,17 @@ struct LiveRun {
 // Logger + tracker + driver + ego pose, one lap of the scenario; then the same lap offline.
 // The lap is published at `rate` data seconds per wall second (the processes' --rate): the
 // messages, and so the tracks, are the same at any pace; only how long the test waits changes.
-// kill_tracker_after_s > 0: the tracker is killed (SIGKILL) that many seconds into the lap and
-// started again at once; both then take their ids from their start time, as in service.
+// What happens to the live tracker during the lap, at_s seconds into it: killed (SIGKILL) and
+// started again at once, both then taking their ids from their start time as in service; or
+// stopped (SIGSTOP) for stop_s seconds, then continued.
+struct TrackerFault {
+  enum class Kind { kNone, kKill, kStop } kind = Kind::kNone;
+  double at_s = 0.0;    // [s] into the lap
+  double stop_s = 0.0;  // [s] kStop: how long
+};
+
 LiveRun RunLive(const std::string& scenario, double duration_s, double rate = 1.0,
-                double kill_tracker_after_s = 0.0) {
+                TrackerFault fault = {}) {
   if (rate != 1.0) std::printf("publishing at %.3f x real time\n", rate);
   LiveRun run;
   run.dir = ScratchDir("tracker_live_" + scenario);
@@ -96,7 +103,7 @@ LiveRun RunLive(const std::string& scenario, double duration_s, double rate = 1.
   {
     Subprocess logger({"lcm-logger", "-q", "-f", kLoggerUrl, run.live_log}, run.dir + "/logger.txt");
     // Ids from 1, as offline (live, they start from the start time): compared one to one below.
-    const bool kill = kill_tracker_after_s > 0.0;
+    const bool kill = fault.kind == TrackerFault::Kind::kKill;
     std::vector<std::string> tracker_argv = {Bin("vtrack-tracker")};
     if (!kill) tracker_argv.insert(tracker_argv.end(), {"--first-track-id", "1"});
     auto tracker = std::make_unique<Subprocess>(tracker_argv, run.dir + "/tracker.txt");
@@ -107,9 +114,16 @@ LiveRun RunLive(const std::string& scenario, double duration_s, double rate = 1.
     Subprocess driver({Bin("vtrack-ladar-driver"), "--scenario", scenario, "--start-utime", u,
                        "--duration", d, "--laps", "1", "--rate", r, "-q"},
                       run.dir + "/driver.txt");
-    if (kill) {
-      const std::int64_t at = run.start_utime + static_cast<std::int64_t>(kill_tracker_after_s / rate * 1e6);
+    if (fault.kind != TrackerFault::Kind::kNone) {
+      const std::int64_t at = run.start_utime + static_cast<std::int64_t>(fault.at_s / rate * 1e6);
       std::this_thread::sleep_for(std::chrono::microseconds(std::max<std::int64_t>(0, at - lcm_util::WallUtime())));
+    }
+    if (fault.kind == TrackerFault::Kind::kStop) {
+      tracker->Signal(SIGSTOP);
+      std::this_thread::sleep_for(std::chrono::microseconds(static_cast<std::int64_t>(fault.stop_s * 1e6)));
+      tracker->Signal(SIGCONT);
+    }
+    if (kill) {
       run.killed_utime = lcm_util::WallUtime();
       tracker->Signal(SIGKILL);
       const auto rk = tracker->Wait(5s);
@@ -174,7 +188,7 @@ TEST(TrackerLiveTest, Fig4TurnLiveEveryVehicleTrackedNoIdentitySwitchSameAsOffli
 // first TRACKS. Told apart by the logger's receive time of each TRACKS message.
 TEST(TrackerLiveTest, KilledTrackerRestartsWithNewIdsAndItsTracksBackWithin1s) {
   VTRACK_REQUIRE_PRIVATE_NETNS();
-  const LiveRun run = RunLive("paper_fig4_turn", 16.0, 1.0, 8.0);
+  const LiveRun run = RunLive("paper_fig4_turn", 16.0, 1.0, {TrackerFault::Kind::kKill, 8.0});
   ASSERT_GT(run.restarted_utime, run.killed_utime);
   std::set<std::int64_t> before_ids;
   int confirmed_before = 0, lists_before = 0, lists_after = 0;
@@ -215,6 +229,40 @@ TEST(TrackerLiveTest, KilledTrackerRestartsWithNewIdsAndItsTracksBackWithin1s) {
   }
   std::printf("after the restart: %d confirmed vehicles within 1 s of its first TRACKS\n", back_within_1s);
   EXPECT_GE(back_within_1s, confirmed_before);
+}
+
+std::int64_t Reason(const tracker_status_t& s, const std::string& reason) {
+  for (int i = 0; i < s.num_reasons; ++i) {
+    if (s.reject_reason[i] == reason) return s.reject_count[i];
+  }
+  return 0;
+}
+
+// The live tracker stopped (SIGSTOP) for 3 s mid-lap: on resuming it finds 3 s of poses and scans
+// waiting, and whatever its receive queues could not hold is lost. Every pose and scan the
+// publishers sent (counted by lcm-logger, which was never stopped) is either received or counted
+// lost (pose_gap, scan_seq_gap), and with the queues sized for the stall nothing is lost.
+TEST(TrackerLiveTest, StoppedTrackerLosesNothingUncounted) {
+  VTRACK_REQUIRE_PRIVATE_NETNS();
+  const LiveRun run = RunLive("paper_fig4_turn", 16.0, 1.0, {TrackerFault::Kind::kStop, 6.0, 3.0});
+  std::int64_t poses_sent = 0, scans_sent = 0;
+  lcm_util::LogReader reader(run.live_log);
+  while (const lcm::LogEvent* ev = reader.Next()) {
+    poses_sent += ev->channel == "EGO_POSE";
+    scans_sent += ev->channel == "LADAR_SCAN";
+  }
+  const tracker_status_t st = LastStatus(run.live_log);
+  const std::int64_t pose_gap = Reason(st, "pose_gap"), scan_gap = Reason(st, "scan_seq_gap");
+  std::printf("poses sent %lld, received %lld, counted lost %lld; scans sent %lld, received %lld, "
+              "counted lost %lld\n",
+              static_cast<long long>(poses_sent), static_cast<long long>(st.poses_received),
+              static_cast<long long>(pose_gap), static_cast<long long>(scans_sent),
+              static_cast<long long>(st.scans_received), static_cast<long long>(scan_gap));
+  ASSERT_GT(poses_sent, 1500);  // 16 s at 100 Hz
+  EXPECT_EQ(st.poses_received + pose_gap, poses_sent);
+  EXPECT_EQ(st.scans_received + scan_gap, scans_sent);
+  EXPECT_EQ(pose_gap, 0);
+  EXPECT_EQ(scan_gap, 0);
 }
 
 TEST(TrackerLiveTest, UrbanIntersectionLiveWith64LayerScans) {

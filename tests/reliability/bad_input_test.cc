@@ -260,7 +260,7 @@ TEST_F(BadInputTest, NanAndInfReturnsGiveTheTracksOfTheScanWithoutThem) {
 
 TEST_F(BadInputTest, AbsurdReturnsScansAndPosesAreRefusedAndCounted) {
   // Returns no sensor can have measured (3e38 m, twice the scan's max_range, a ring outside
-  // [0, num_rings)) are refused one by one: the tracks are those of the scans without them.
+  // [-1, num_rings), -1 meaning unknown) are refused one by one: the tracks are those of the scans without them.
   // Scans with a negative num_rings or a NaN / negative max_range, and ego poses 1e300 m or
   // 2e7 m away, are refused whole: every TRACKS message as in the clean run.
   const Output clean = Run({});
@@ -275,7 +275,7 @@ TEST_F(BadInputTest, AbsurdReturnsScansAndPosesAreRefusedAndCounted) {
     };
     add(3e38f, 1.0f, 0); add(-2.0f, 3e38f, 0); add(2.0f * s->max_range, 0.0f, 0);
     far += 3;
-    add(5.0f, 1.0f, s->num_rings); add(6.0f, -1.0f, -1); add(7.0f, 0.0f, 32767);
+    add(5.0f, 1.0f, s->num_rings); add(6.0f, -1.0f, -2); add(7.0f, 0.0f, 32767);
     bad_ring += 3;
     s->npoints = static_cast<std::int32_t>(s->x.size());
   };

@@ -141,7 +141,8 @@ struct ReturnFilter {
       ++stats->far;
       return false;
     }
-    if (has_ring && (scan.ring[i] < 0 || scan.ring[i] >= num_rings)) {
+    // -1: the ring is unknown (a KITTI frame whose lasers could not be told apart): kept.
+    if (has_ring && (scan.ring[i] < -1 || scan.ring[i] >= num_rings)) {
       ++stats->bad_ring;
       return false;
     }

@@ -58,7 +58,7 @@ struct PreprocessStats {
   std::int64_t input = 0;         // returns in the scan
   std::int64_t nonfinite = 0;     // NaN / Inf coordinates
   std::int64_t far = 0;           // beyond the sensor's max_range or kMaxReturnRange: absurd
-  std::int64_t bad_ring = 0;      // ring outside [0, num_rings)
+  std::int64_t bad_ring = 0;      // ring outside [-1, num_rings) (-1: unknown)
   std::int64_t bad_time = 0;      // dt_us outside [0, sweep_duration_us]
   std::int64_t out_of_range = 0;  // nearer than min_range or farther than max_range
   std::int64_t ground = 0;        // removed as ground or above max_height

@@ -190,7 +190,7 @@ bool Tracker::Preprocess(const LadarScan& scan, bool extrapolate, PreprocessResu
                  at + ": " + Str(pre->stats.far) +
                      " returns beyond the sensor's max_range or the absolute bound dropped");
   rejects_.Count("bad_ring", pre->stats.bad_ring,
-                 at + ": " + Str(pre->stats.bad_ring) + " returns with a ring outside [0, num_rings) dropped");
+                 at + ": " + Str(pre->stats.bad_ring) + " returns with a ring outside [-1, num_rings) dropped");
   rejects_.Count("bad_point_time", pre->stats.bad_time,
                  at + ": " + Str(pre->stats.bad_time) + " returns with dt_us outside the sweep dropped");
   return true;

@@ -272,3 +272,34 @@ TEST(TrackerFused, WithoutTheSwitchTheSizeRulesClassTheParkedCarAVehicle) {
 
 }  // namespace
 }  // namespace vtrack
+
+namespace vtrack {
+namespace {
+
+// Detection lists lost on the way show as gaps in their seq: one count per missing list, as for
+// scans; lists whose pose cannot be found have reasons of their own (not the scans' reasons).
+TEST(TrackerBoxes, LostListsAreCountedFromSeqGaps) {
+  TrackerParams params;
+  params.detections.mode = InputMode::kBoxes;
+  Tracker tracker(params);
+  std::vector<ScanOutput> out;
+  int lost = 0;
+  for (int k = 0; k < 40; ++k) {
+    const std::int64_t t = kT0 + k * 100'000;
+    tracker.AddPose({t, Eigen::Isometry3d::Identity()}, &out);
+    if (k % 7 == 3 || (k >= 20 && k < 25)) {
+      ++lost;
+      continue;
+    }
+    DetectionList list;
+    list.utime = t;
+    list.seq = 1000 + k;
+    tracker.AddDetections(std::move(list), &out);
+  }
+  ASSERT_GT(lost, 5);
+  EXPECT_EQ(tracker.rejects().at("detections_seq_gap"), lost);
+  EXPECT_EQ(tracker.rejects().count("scan_seq_gap"), 0u);
+}
+
+}  // namespace
+}  // namespace vtrack

@@ -215,10 +215,7 @@ int main(int argc, char** argv) {
     // Every argument is an option: a stray one (a log file without --input) would otherwise be
     // ignored and the tracker would go live instead.
     if (!vm.count("help")) lcm_util::RefuseStrayArguments(parsed);
-    for (const char* key : {"scan-channel", "pose-channel", "detections-channel", "tracks-channel",
-                            "debug-channel", "status-channel"}) {
-      lcm_util::RefuseEmpty(vm, key);
-    }
+    lcm_util::RefuseEmptyChannels(vm);
   } catch (const po::error& e) {
     std::cerr << "vtrack-tracker: " << e.what() << "\n(see --help)\n";
     return 2;

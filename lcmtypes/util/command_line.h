@@ -6,6 +6,7 @@
 
 #include <iostream>
 #include <string>
+#include <typeinfo>
 
 namespace vtrack::lcm_util {
 
@@ -22,17 +23,24 @@ inline void RefuseStrayArguments(const boost::program_options::parsed_options& p
   }
 }
 
-// Throws boost::program_options::error unless value is non-empty (a channel name).
-inline void RefuseEmpty(const boost::program_options::variables_map& vm, const char* key) {
-  if (vm.count(key) && vm[key].as<std::string>().empty()) {
-    throw boost::program_options::error(std::string("--") + key + " must not be empty");
+// Throws boost::program_options::error if a channel option ("channel" or "...-channel", a
+// string) is empty: LCM would publish on, or subscribe to, a channel no one else names.
+inline void RefuseEmptyChannels(const boost::program_options::variables_map& vm) {
+  for (const auto& [key, value] : vm) {
+    const bool channel = key == "channel" ||
+                         (key.size() > 8 && key.compare(key.size() - 8, 8, "-channel") == 0);
+    if (!channel || value.empty() || value.value().type() != typeid(std::string)) continue;
+    if (value.as<std::string>().empty()) {
+      throw boost::program_options::error("--" + key + " must not be empty");
+    }
   }
 }
 
 // Stores parsed into *vm. If --help is among the options, prints usage (if not empty, followed by
 // a blank line) and help to stdout and returns false: the process should exit 0. Otherwise runs
 // the notifiers and returns true. Throws boost::program_options::error for a bad command line,
-// including an argument that is not an option (RefuseStrayArguments).
+// including an argument that is not an option (RefuseStrayArguments) and an empty channel
+// (RefuseEmptyChannels).
 inline bool StoreCommandLine(const boost::program_options::parsed_options& parsed,
                              const boost::program_options::options_description& help,
                              boost::program_options::variables_map* vm,
@@ -45,6 +53,7 @@ inline bool StoreCommandLine(const boost::program_options::parsed_options& parse
     return false;
   }
   boost::program_options::notify(*vm);
+  RefuseEmptyChannels(*vm);
   return true;
 }
 

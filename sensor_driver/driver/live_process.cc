@@ -4,7 +4,6 @@
 #include <exception>
 #include <stdexcept>
 
-#include "lcmtypes/util/command_line.h"
 #include "lcmtypes/util/process.h"
 
 namespace vtrack::sim {
@@ -43,9 +42,6 @@ std::optional<int> ParseLiveCommandLine(int argc, char** argv, const po::options
       throw po::error("give at most one of --poses and --oxts");
     }
     CheckRealtimeOptions(given);
-    for (const char* key : {"scan-channel", "truth-channel", "channel"}) {
-      lcm_util::RefuseEmpty(given, key);
-    }
   };
   return ParseSimCommandLine(argc, argv, desc, usage, name, check, vm, cli);
 }

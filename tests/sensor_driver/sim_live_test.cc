@@ -217,6 +217,16 @@ TEST(SimLiveTest, NonFiniteNumbersStrayArgumentsAndEmptyChannelsAreRefused) {
   refused("vtrack-ladar-driver", with({"--truth-channel", ""}), "--truth-channel must not be empty");
   refused("vtrack-ego-pose", with({"--channel", ""}), "--channel must not be empty");
   refused("vtrack-ego-pose", with({"--pose-rate", "nan"}), "--pose-rate");
+  // The log writer shares the channel and number checks.
+  const std::vector<std::string> to_log = {"--scenario", "paper_fig4_turn", "--out", dir + "/never.lcm"};
+  auto log_with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> a = to_log;
+    a.insert(a.end(), extra.begin(), extra.end());
+    return a;
+  };
+  refused("vtrack-sim-log", log_with({"--pose-channel", ""}), "--pose-channel must not be empty");
+  refused("vtrack-sim-log", log_with({"--duration", "inf"}), "--duration");
+  refused("vtrack-sim-log", log_with({"stray"}), "unexpected argument 'stray'");
 }
 
 // No --start-utime: the ego-pose process and the driver, started 1.3 s apart, each join the lap in

@@ -9,7 +9,8 @@
 //
 // Oracle (std::abort with a message on any violation, besides the sanitizers):
 //  - the node never throws and never reports an internal error;
-//  - scans received = processed + dropped + queued, after every message;
+//  - scans received = processed + dropped + queued, after every message, and every dropped scan
+//    is counted under exactly one scan reason (dropped = their sum, tracker/README.md);
 //  - every TRACKS / TRACK_DEBUG / TRACKER_STATUS message decodes (Decode<T>) and every reported
 //    track has finite position, heading, covariance (with a non-negative diagonal) and size;
 //  - track ids are unique within a message and an id that has disappeared never comes back;
@@ -291,6 +292,15 @@ class Harness {
       Fail("scans received " + std::to_string(t.scans_received()) + " != processed " +
            std::to_string(t.scans_processed()) + " + dropped " + std::to_string(t.scans_dropped()) +
            " + queued " + std::to_string(t.queued_scans()));
+    }
+    std::int64_t by_reason = 0;
+    for (const char* k : {"empty_scan", "huge_scan", "bad_scan", "scan_repeated", "scan_out_of_order",
+                          "scan_overrun", "scan_time_jump", "scan_reset", "pose_missing", "stale_pose"}) {
+      by_reason += Reject(k);
+    }
+    if (by_reason != t.scans_dropped()) {
+      Fail("scans dropped " + std::to_string(t.scans_dropped()) + " != " + std::to_string(by_reason) +
+           " counted by scan reason");
     }
     const tracker_status_t st = node_->Status();
     for (int i = 0; i < st.num_reasons; ++i) {

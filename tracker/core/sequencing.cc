@@ -105,6 +105,8 @@ void ScanSequencer::Reset(const std::string& why) {
   scans_dropped_ += queued;
   rejects_->Count("scan_reset", queued, Str(queued) + " queued scans dropped by a reset");
   queue_.clear();
+  const auto lists = static_cast<std::int64_t>(detections_.size());
+  rejects_->Count("detections_reset", lists, Str(lists) + " queued detection lists dropped by a reset");
   detections_.clear();
   have_detections_ = false;
   poses_.Clear();

@@ -301,5 +301,26 @@ TEST(TrackerBoxes, LostListsAreCountedFromSeqGaps) {
   EXPECT_EQ(tracker.rejects().count("scan_seq_gap"), 0u);
 }
 
+// Lists waiting for poses when the input resets (a jump in time confirmed by the next message)
+// are dropped and counted.
+TEST(TrackerBoxes, ListsQueuedAtAResetAreCounted) {
+  TrackerParams params;
+  params.detections.mode = InputMode::kBoxes;
+  Tracker tracker(params);
+  std::vector<ScanOutput> out;
+  for (int k = 0; k < 3; ++k) {  // no pose yet: they wait
+    DetectionList list;
+    list.utime = kT0 + k * 10'000;
+    list.seq = k;
+    tracker.AddDetections(std::move(list), &out);
+  }
+  const std::int64_t hour = 3'600'000'000;
+  tracker.AddPose({kT0 + hour, Eigen::Isometry3d::Identity()}, &out);           // refused
+  tracker.AddPose({kT0 + hour + 10'000, Eigen::Isometry3d::Identity()}, &out);  // confirms: reset
+  EXPECT_EQ(tracker.resets(), 1);
+  EXPECT_EQ(tracker.rejects().at("detections_reset"), 3);
+  EXPECT_TRUE(out.empty());
+}
+
 }  // namespace
 }  // namespace vtrack

@@ -79,9 +79,6 @@ struct LiveRun {
   std::int64_t killed_utime = 0, restarted_utime = 0;
 };
 
-// Logger + tracker + driver + ego pose, one lap of the scenario; then the same lap offline.
-// The lap is published at `rate` data seconds per wall second (the processes' --rate): the
-// messages, and so the tracks, are the same at any pace; only how long the test waits changes.
 // What happens to the live tracker during the lap, at_s seconds into it: killed (SIGKILL) and
 // started again at once, both then taking their ids from their start time as in service; or
 // stopped (SIGSTOP) for stop_s seconds, then continued.
@@ -91,6 +88,9 @@ struct TrackerFault {
   double stop_s = 0.0;  // [s] kStop: how long
 };
 
+// Logger + tracker + driver + ego pose, one lap of the scenario; then the same lap offline.
+// The lap is published at `rate` data seconds per wall second (the processes' --rate): the
+// messages, and so the tracks, are the same at any pace; only how long the test waits changes.
 LiveRun RunLive(const std::string& scenario, double duration_s, double rate = 1.0,
                 TrackerFault fault = {}) {
   if (rate != 1.0) std::printf("publishing at %.3f x real time\n", rate);

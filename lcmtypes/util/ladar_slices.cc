@@ -201,6 +201,22 @@ std::vector<ladar_slice_t> SliceSweep(const ladar_scan_t& scan, int count) {
   return slices;
 }
 
+std::optional<int> ParseSlicesOption(const std::string& text) {
+  if (text == "auto") return kSlicesAuto;
+  if (text.empty() || text.size() > 5 ||
+      !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+    return std::nullopt;
+  }
+  const int n = std::stoi(text);
+  if (n > kMaxSlicesPerSweep) return std::nullopt;
+  return n;
+}
+
+int SlicesFor(int option, const ladar_scan_t& scan) {
+  if (option != kSlicesAuto) return option;
+  return scan.num_rings > 1 ? AutoSliceCount(scan) : 0;
+}
+
 double AssembledSweep::MissingDeg() const {
   double w = 0.0;
   for (const AzimuthArc& a : missing) w += a.width();

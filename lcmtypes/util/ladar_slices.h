@@ -34,6 +34,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -68,6 +69,14 @@ int AutoSliceCount(const ladar_scan_t& scan, std::int64_t max_bytes = kMaxDatagr
 // or 0 for AutoSliceCount(scan). Throws std::invalid_argument for a count out of range or
 // parallel arrays of different lengths.
 std::vector<ladar_slice_t> SliceSweep(const ladar_scan_t& scan, int count);
+
+// The drivers' --slices option: "auto" (kSlicesAuto), "0" (whole sweeps, one ladar_scan_t each)
+// or a count N in [1, kMaxSlicesPerSweep]. nullopt for anything else.
+inline constexpr int kSlicesAuto = -1;
+std::optional<int> ParseSlicesOption(const std::string& text);
+// How many slices to send scan as under that option: 0 = whole; auto: AutoSliceCount for a 3-D
+// sweep (num_rings > 1, megabytes), 0 for a single-plane one (it fits one datagram already).
+int SlicesFor(int option, const ladar_scan_t& scan);
 
 // A sweep put back together.
 struct AssembledSweep {

@@ -63,6 +63,7 @@ int RunLive(const TrackerParams& params, NodeOptions options, const std::string&
                    });
   LiveHandler handler(&node);
   lcm->subscribe(options.scan_channel, &LiveHandler::OnMessage, &handler);
+  lcm->subscribe(options.slice_channel, &LiveHandler::OnMessage, &handler);
   lcm->subscribe(options.pose_channel, &LiveHandler::OnMessage, &handler);
   if (params.detections.mode != InputMode::kScans) {
     lcm->subscribe(options.detections_channel, &LiveHandler::OnMessage, &handler);
@@ -174,6 +175,8 @@ int main(int argc, char** argv) {
        "LCM URL for live mode ('' = $LCM_DEFAULT_URL or LCM's default); recv_buf_size=4194304 "
        "is appended to udpm:// URLs that lack it")
       ("scan-channel", po::value(&options.scan_channel)->default_value("LADAR_SCAN"), "input scans")
+      ("slice-channel", po::value(&options.slice_channel)->default_value("LADAR_SLICE"),
+       "input sweeps sent as slices (ladar_slice_t)")
       ("pose-channel", po::value(&options.pose_channel)->default_value("EGO_POSE"), "input ego poses")
       ("detections-channel", po::value(&options.detections_channel)->default_value("DETECTIONS"),
        "input detector boxes (input modes boxes and fused)")

@@ -156,6 +156,7 @@ bool Tracker::Process(const LadarScan& scan, bool extrapolate, ScanOutput* out) 
   // Association with the tracks predicted to the middle of the sweep.
   manager_->Predict(scan.utime + scan.sweep_duration_us / 2, &predicted_);
   associator_.Run(predicted_, points_, segments_, pre.sensor_xy, &association_);
+  MarkUnobserved(scan, extrapolate);
   // Each track updated with its returns; new tracks from what is left; life cycle; report.
   UpdateTracks(scan, pre.sensor_xy, out);
   CreateTracks(scan, pre.sensor_xy);
@@ -186,6 +187,37 @@ bool Tracker::Preprocess(const LadarScan& scan, bool extrapolate, PreprocessResu
   return true;
 }
 
+void Tracker::MarkUnobserved(const LadarScan& scan, bool extrapolate) {
+  unobserved_.assign(predicted_.size(), 0);
+  if (scan.lost_wedges.empty()) return;
+  const std::int64_t mid = scan.utime + scan.sweep_duration_us / 2;
+  const std::optional<Eigen::Isometry3d> world_from_body =
+      sequencer_.poses().At(mid, extrapolate ? params_.input.max_extrapolation_us : 0);
+  if (!world_from_body) return;  // Preprocess placed the sweep, so this does not happen
+  const Eigen::Isometry3d sensor_from_world = (*world_from_body * scan.body_from_sensor).inverse();
+  const double sensor_z = (*world_from_body * scan.body_from_sensor).translation().z();
+  std::int64_t unobserved = 0;
+  for (std::size_t j = 0; j < predicted_.size(); ++j) {
+    const Eigen::Vector2d& c = predicted_[j].box.center;
+    const Eigen::Vector3d p = sensor_from_world * Eigen::Vector3d(c.x(), c.y(), sensor_z);
+    const double azimuth = std::atan2(p.y(), p.x());
+    for (const AzimuthWedge& w : scan.lost_wedges) {
+      if (w.Contains(azimuth)) {
+        unobserved_[j] = 1;
+        ++unobserved;
+        break;
+      }
+    }
+  }
+  rejects_.Count("sweep_partial", 1,
+                 "scan " + Str(scan.seq) + " at " + Str(scan.utime) + ": " +
+                     Str(static_cast<std::int64_t>(scan.lost_wedges.size())) +
+                     " wedges lost on the way, processed without them");
+  rejects_.Count("track_in_lost_wedge", unobserved,
+                 "scan " + Str(scan.seq) + ": " + Str(unobserved) +
+                     " tracks in lost wedges not counted as missed");
+}
+
 void Tracker::UpdateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_xy,
                            ScanOutput* out) {
   // 3-D clouds only: a single-plane scanner's bearing spacing (0.5 deg or more) leaves bins of
@@ -199,7 +231,7 @@ void Tracker::UpdateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_
   for (std::size_t j = 0; j < num_tracks; ++j) {
     const auto& idx = association_.track_points[j];
     if (idx.empty()) {
-      manager_->Miss(j);
+      if (!unobserved_[j]) manager_->Miss(j);
       continue;
     }
     outline_.Extract(points_, idx, scan, sensor_xy, &point_set_);

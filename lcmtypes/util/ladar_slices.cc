@@ -50,18 +50,25 @@ std::vector<Column> Columns(const ladar_scan_t& scan) {
   return cols;
 }
 
-// Where the arcs start (the first column's azimuth) and the direction the sensor turned (+1
-// counter-clockwise, -1 clockwise: the sign of the summed steps from column to column).
+// Where the arcs start and the direction the sensor turned (+1 counter-clockwise, -1 clockwise:
+// the sign of the summed steps from column to column). The start lies half a column step before
+// the first column, so that no column sits on the seam (the layers of one column differ in
+// azimuth by float rounding).
 void StartAndDirection(const std::vector<Column>& cols, double* start, double* direction) {
-  *start = 0.0;
-  double total = 0.0, prev = std::nan("");
+  double first = 0.0, total = 0.0, first_step = 0.0, prev = std::nan("");
   for (const Column& c : cols) {
     if (std::isnan(c.azimuth)) continue;
-    if (std::isnan(prev)) *start = c.azimuth;
-    else total += AngleDiff(c.azimuth, prev);
+    if (std::isnan(prev)) {
+      first = c.azimuth;
+    } else {
+      const double step = AngleDiff(c.azimuth, prev);
+      if (first_step == 0.0) first_step = std::abs(step);
+      total += step;
+    }
     prev = c.azimuth;
   }
   *direction = total < 0.0 ? -1.0 : 1.0;
+  *start = first - *direction * 0.5 * first_step;
 }
 
 // The arc (0 .. count-1) of every column; a column without a finite return goes with the one

@@ -7,8 +7,9 @@
 //
 // Slicing (SliceSweep). The sweep's returns are taken column by column (a run of consecutive
 // returns with the same dt_us: one firing of every layer), so a column is never split. The full
-// circle is cut into `count` equal arcs, starting at the azimuth of the first column and following
-// the direction the sensor turned (the sign of the summed azimuth steps between columns), and
+// circle is cut into `count` equal arcs, starting half a column step before the first column
+// (no column on the seam) and following the direction the sensor turned (the sign of the summed
+// azimuth steps between columns), and
 // every column goes to the arc that holds the azimuth of its first finite return. Slice k holds
 // the columns of the k-th arc in their order in the sweep, so for a rotating sensor, whose
 // returns come in firing order, the slices concatenated in index order are the sweep's returns

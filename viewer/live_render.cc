@@ -27,7 +27,7 @@ LiveRenderer::LiveRenderer(lcm::LCM* lcm, const RenderJob& job, Sink sink,
       router_(job.channels, &assembler_),
       last_message_(std::chrono::steady_clock::now()) {
   if (const std::string err = job_.FirstProblem(); !err.empty()) throw std::invalid_argument(err);
-  for (const std::string* ch : {&job_.channels.scan, &job_.channels.pose, &job_.channels.tracks,
+  for (const std::string* ch : {&job_.channels.scan, &job_.channels.slice, &job_.channels.pose, &job_.channels.tracks,
                                 &job_.channels.debug, &job_.channels.truth}) {
     // LCM subscribes by regular expression: anchor the literal channel name.
     std::string pattern;
@@ -101,6 +101,7 @@ void LiveRenderer::RenderLoop() {
 void LiveRenderer::Finish() {
   if (finished_) return;
   finished_ = true;
+  router_.Flush();
   Offer(assembler_.Flush());
   slot_.Close();
   if (render_thread_.joinable()) render_thread_.join();

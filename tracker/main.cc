@@ -63,7 +63,10 @@ int RunLive(const TrackerParams& params, NodeOptions options, const std::string&
                    });
   LiveHandler handler(&node);
   lcm->subscribe(options.scan_channel, &LiveHandler::OnMessage, &handler);
-  lcm->subscribe(options.slice_channel, &LiveHandler::OnMessage, &handler);
+  // A sweep's slices come in a burst of dozens while the previous sweep is processed: LCM's
+  // default queue of 30 messages per subscription would drop the rest of the sweep.
+  lcm->subscribe(options.slice_channel, &LiveHandler::OnMessage, &handler)
+      ->setQueueCapacity(lcm_util::kSliceQueueCapacity);
   lcm->subscribe(options.pose_channel, &LiveHandler::OnMessage, &handler);
   if (params.detections.mode != InputMode::kScans) {
     lcm->subscribe(options.detections_channel, &LiveHandler::OnMessage, &handler);
@@ -92,6 +95,10 @@ int RunLive(const TrackerParams& params, NodeOptions options, const std::string&
                static_cast<long long>(node.tracker().scans_received()),
                static_cast<long long>(node.tracker().scans_processed()),
                static_cast<long long>(node.tracker().scans_dropped()));
+  std::fprintf(stderr, "vtrack-tracker: %lld slices received; %lld returns received, %lld processed\n",
+               static_cast<long long>(node.assembler().slices_accepted()),
+               static_cast<long long>(node.returns_received()),
+               static_cast<long long>(node.tracker().returns_processed()));
   return 0;
 }
 

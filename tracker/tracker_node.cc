@@ -46,11 +46,13 @@ void TrackerNode::Handle(const std::string& channel, const void* data, std::size
     if (channel == options_.scan_channel) {
       ladar_scan_t msg;
       if (!DecodeOrCount(channel, data, size, &msg)) return;
+      returns_received_ += msg.npoints;
       NoteArrival(msg.utime);
       tracker_.AddScan(ScanFromLcm(std::move(msg)), &outs_);
     } else if (channel == options_.slice_channel) {
       ladar_slice_t msg;
       if (!DecodeOrCount(channel, data, size, &msg)) return;
+      returns_received_ += msg.npoints;
       assembler_.Add(std::move(msg), &sweeps_);
       FeedSweeps();
     } else if (channel == options_.pose_channel) {

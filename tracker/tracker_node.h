@@ -57,6 +57,8 @@ class TrackerNode {
   std::int64_t decode_errors() const { return decode_errors_; }
   std::int64_t tracks_published() const { return tracks_published_; }
   const lcm_util::SweepAssembler& assembler() const { return assembler_; }
+  // Returns in the scans and slices decoded (before any check of the core).
+  std::int64_t returns_received() const { return returns_received_; }
 
  private:
   // Decodes a message (checked); a bad one is counted by reason and warned about.
@@ -77,6 +79,7 @@ class TrackerNode {
   std::map<std::string, std::int64_t> decode_reasons_;
   std::int64_t decode_errors_ = 0;
   std::int64_t tracks_published_ = 0;
+  std::int64_t returns_received_ = 0;
   std::deque<std::pair<std::int64_t, std::int64_t>> arrival_;  // (scan utime, wall utime)
   std::deque<double> latencies_ms_;
   double last_latency_ms_ = 0.0;

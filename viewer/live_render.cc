@@ -36,6 +36,7 @@ LiveRenderer::LiveRenderer(lcm::LCM* lcm, const RenderJob& job, Sink sink,
       pattern += c;
     }
     subscriptions_.push_back(lcm_->subscribe(pattern, &LiveRenderer::OnMessage, this));
+    if (ch == &job_.channels.slice) subscriptions_.back()->setQueueCapacity(lcm_util::kSliceQueueCapacity);
   }
   render_thread_ = std::thread([this] { RenderLoop(); });
 }

@@ -79,6 +79,12 @@ std::optional<int> ParseSlicesOption(const std::string& text);
 // sweep (num_rings > 1, megabytes), 0 for a single-plane one (it fits one datagram already).
 int SlicesFor(int option, const ladar_scan_t& scan);
 
+// [messages] Queue capacity for a live LADAR_SLICE subscription (lcm::Subscription::
+// setQueueCapacity): LCM drops messages beyond 30 queued per subscription by default, and a sweep
+// arrives as a burst of dozens of slices (45 for velodyne64) while the subscriber is still busy
+// with the one before. 1024 slices: ~20 such sweeps, ~64 MB at most.
+inline constexpr int kSliceQueueCapacity = 1024;
+
 // A sweep put back together.
 struct AssembledSweep {
   ladar_scan_t scan;                 // header of the sweep, returns of the received slices

@@ -105,6 +105,7 @@ void Tracker::ProcessReady(bool flush, std::vector<ScanOutput>* out) {
       continue;
     }
     const bool processed = Process(*scan, scan_extrapolate, &o);
+    if (processed) returns_processed_ += static_cast<std::int64_t>(scan->size());
     if (processed) out->push_back(std::move(o));
     sequencer_.Done(processed);
   }

@@ -70,6 +70,7 @@ class Tracker {
   // Counters since construction.
   std::int64_t scans_received() const { return sequencer_.scans_received(); }
   std::int64_t scans_processed() const { return sequencer_.scans_processed(); }
+  std::int64_t returns_processed() const { return returns_processed_; }  // in processed scans
   std::int64_t scans_dropped() const { return sequencer_.scans_dropped(); }
   std::int64_t poses_received() const { return sequencer_.poses_received(); }
   std::int64_t resets() const { return sequencer_.resets(); }
@@ -123,6 +124,7 @@ class Tracker {
   PointSet point_set_;
   RangeProfile profile_;  // nearest return per bearing of the scan being processed
   std::vector<char> unobserved_;  // per track: in a lost wedge of the scan being processed
+  std::int64_t returns_processed_ = 0;
 };
 
 }  // namespace vtrack

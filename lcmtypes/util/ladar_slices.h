@@ -103,7 +103,10 @@ class SweepAssembler {
     // a larger window waits for slices reordered across sweeps, at the cost of latency).
     std::int64_t reorder_window_us = 0;
     // [us] Expire() hands on a sweep whose end lies this far before the time it is given.
-    std::int64_t timeout_us = 100'000;
+    // Long: a partial sweep is normally handed on by the next sweep's first slice; this is for a
+    // stream that stops, and a driver descheduled in the middle of its burst must not see the
+    // rest of its sweep refused as late.
+    std::int64_t timeout_us = 1'000'000;
   };
 
   SweepAssembler() : SweepAssembler(Options{}) {}

@@ -190,13 +190,18 @@ bool Tracker::Preprocess(const LadarScan& scan, bool extrapolate, PreprocessResu
 
 void Tracker::MarkUnobserved(const LadarScan& scan, bool extrapolate) {
   unobserved_.assign(predicted_.size(), 0);
+  lost_world_.clear();
   if (scan.lost_wedges.empty()) return;
   const std::int64_t mid = scan.utime + scan.sweep_duration_us / 2;
   const std::optional<Eigen::Isometry3d> world_from_body =
       sequencer_.poses().At(mid, extrapolate ? params_.input.max_extrapolation_us : 0);
   if (!world_from_body) return;  // Preprocess placed the sweep, so this does not happen
   const Eigen::Isometry3d sensor_from_world = (*world_from_body * scan.body_from_sensor).inverse();
-  const double sensor_z = (*world_from_body * scan.body_from_sensor).translation().z();
+  // Lost wedges in world bearings (level sensor: its yaw) hide faces' ends (UpdateTracks).
+  const Eigen::Isometry3d world_from_sensor = *world_from_body * scan.body_from_sensor;
+  const double sensor_z = world_from_sensor.translation().z();
+  const double yaw = std::atan2(world_from_sensor.linear()(1, 0), world_from_sensor.linear()(0, 0));
+  for (const AzimuthWedge& w : scan.lost_wedges) lost_world_.push_back({w.begin + yaw, w.end + yaw});
   std::int64_t unobserved = 0;
   for (std::size_t j = 0; j < predicted_.size(); ++j) {
     const Eigen::Vector2d& c = predicted_[j].box.center;
@@ -227,6 +232,7 @@ void Tracker::UpdateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_
   if (multi_ring) {
     profile_.Build(sensor_xy, points_.x, points_.y, points_.ring,
                    std::max(kMinProfileBinDeg, params_.outline.bin_deg));
+    for (const AzimuthWedge& w : lost_world_) profile_.MarkUnseen(w.begin, w.end);
   }
   const std::size_t num_tracks = manager_->tracks().size();
   for (std::size_t j = 0; j < num_tracks; ++j) {

@@ -124,6 +124,7 @@ class Tracker {
   PointSet point_set_;
   RangeProfile profile_;  // nearest return per bearing of the scan being processed
   std::vector<char> unobserved_;  // per track: in a lost wedge of the scan being processed
+  std::vector<AzimuthWedge> lost_world_;  // the scan's lost wedges as world bearings [rad]
   std::int64_t returns_processed_ = 0;
 };
 

@@ -85,6 +85,12 @@ int SlicesFor(int option, const ladar_scan_t& scan);
 // with the one before. 1024 slices: ~20 such sweeps, ~64 MB at most.
 inline constexpr int kSliceQueueCapacity = 1024;
 
+// [us] Default gap a live driver leaves between the slices of a sweep (45 slices: 13 ms). Debian's
+// lcm-logger keeps LCM's queue of 30 messages per subscription and lost slices and poses behind
+// bursts of 33 slices sent back to back (lcmtypes_logger_test); with 300 us between them it
+// records every one. A sensor's own packets are spread over the whole sweep.
+inline constexpr int kSliceGapUs = 300;
+
 // A sweep put back together.
 struct AssembledSweep {
   ladar_scan_t scan;                 // header of the sweep, returns of the received slices

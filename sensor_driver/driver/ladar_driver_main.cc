@@ -21,7 +21,7 @@ int main(int argc, char** argv) {
   vtrack::sim::AddLiveSourceOptions(
       &desc, vtrack::sim::AddSensorOptions,
       "replay a KITTI tracking sequence from DIR instead of a scenario");
-  vtrack::sim::AddSweepOutputOptions(&desc);
+  vtrack::sim::AddSweepOutputOptions(&desc, /*live=*/true);
   desc.add_options()
       ("truth-channel", po::value<std::string>()->default_value("GROUND_TRUTH"), "channel of the ground truth")
       ("no-truth", "do not publish ground truth");

@@ -22,7 +22,7 @@ int main(int argc, char** argv) {
   vtrack::sim::AddScenarioOptions(&desc, /*start_utime_is_live=*/false);
   vtrack::sim::AddSensorOptions(&desc);
   vtrack::sim::AddPoseOptions(&desc);
-  vtrack::sim::AddSweepOutputOptions(&desc);
+  vtrack::sim::AddSweepOutputOptions(&desc, /*live=*/false);
   desc.add_options()
       ("out,o", po::value<std::string>(), "LCM log file to write (overwritten)")
       ("truth-channel", po::value<std::string>()->default_value("GROUND_TRUTH"), "channel of the ground truth")

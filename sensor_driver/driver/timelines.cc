@@ -14,7 +14,7 @@ void SimScanTimeline::Prepare(int i, std::int64_t lap_start_utime, std::int64_t 
 void SimScanTimeline::Publish() {
   slices_ += SendSweep(output_, scan_, [&](const std::string& ch, const auto& msg) {
     if (lcm_->publish(ch, &msg) < 0) log_.Warn("publish", "publishing " + ch + " failed");
-  });
+  }, /*paced=*/true);
   points_ += scan_.npoints;
   if (!truth_channel_.empty() && lcm_->publish(truth_channel_, &truth_) < 0) {
     log_.Warn("publish_truth", "publishing " + truth_channel_ + " failed");

@@ -501,44 +501,82 @@ TEST(FaultTest, RendererStoppedFor5sNeverDelaysTracks) {
   EXPECT_LE(d.during.back(), std::max(2 * q(d.outside, 0.99), q(d.outside, 0.99) + 20));
 }
 
-TEST(FaultTest, LoggerRecordsEvery2MBScanAt10HzWhileTheTrackerRuns) {
-  const std::string dir = ScratchDir("fault_logger");
-  VTRACK_REQUIRE_PRIVATE_NETNS();
-  const std::string scenario = "urban_intersection";  // 64 layers, ~2.8 MB per scan, 10 Hz
+// The driver's sweeps (urban_intersection: 64 layers, ~2.8 MB each, 10 Hz) as lcm-logger records
+// them beside the tracker, against vtrack-sim-log's: every one, byte for byte. Whole sweeps
+// (--slices 0, LADAR_SCAN), or slices (the default, LADAR_SLICE: keyed by sweep and index).
+void LoggerRecordsEverySweep(bool sliced) {
+  const std::string dir = ScratchDir(sliced ? "fault_logger_sliced" : "fault_logger");
+  const std::string scenario = "urban_intersection";
+  const std::string channel = sliced ? "LADAR_SLICE" : "LADAR_SCAN";
+  const std::vector<std::string> args = sliced ? std::vector<std::string>{}
+                                               : std::vector<std::string>{"--slices", "0"};
   const double duration = 6.0;
-  const int port = 7715;
+  const int port = sliced ? 7716 : 7715;
   const std::int64_t start = lcm_util::WallUtime() + 3'000'000;
   {
-    Pipeline run(dir, scenario, port, start, duration, "LADAR_SCAN|TRACKS", false);
+    Pipeline run(dir, scenario, port, start, duration, channel + "|TRACKS", false, args);
     run.Finish(std::chrono::milliseconds(static_cast<int>((duration + 60) * 1000)));
     EXPECT_EQ(run.tracker_rc, 0) << ReadFile(run.tracker_log);
   }
   const std::string truth = dir + "/truth.lcm";
-  ASSERT_EQ(RunCommand({Bin("vtrack-sim-log"), "--scenario", scenario, "--start-utime", std::to_string(start),
-                        "--duration", std::to_string(duration), "--out", truth, "-q"}, dir + "/sim.txt"), 0);
-  // The logger's scans are the simulator's, every one, byte for byte.
-  std::map<std::int64_t, std::string> want, got;
+  std::vector<std::string> sim = {Bin("vtrack-sim-log"), "--scenario", scenario, "--start-utime",
+                                  std::to_string(start), "--duration", std::to_string(duration),
+                                  "--out", truth, "-q"};
+  sim.insert(sim.end(), args.begin(), args.end());
+  ASSERT_EQ(RunCommand(sim, dir + "/sim.txt"), 0);
+  // The logger's messages are the simulator's, every one, byte for byte; (seq, slice) -> bytes.
+  using Key = std::pair<std::int64_t, int>;
+  std::map<Key, std::string> want, got;
+  std::map<std::int64_t, std::size_t> sweep_bytes;
   std::size_t largest = 0;
-  auto read = [](const std::string& path, std::map<std::int64_t, std::string>* out, std::size_t* largest) {
+  auto read = [&](const std::string& path, std::map<Key, std::string>* out, bool count) {
     lcm_util::LogReader r(path);
     while (const lcm::LogEvent* ev = r.Next()) {
-      ladar_scan_t s;
-      if (ev->channel != "LADAR_SCAN" || lcm_util::Decode(ev->data, static_cast<std::size_t>(ev->datalen), &s) != lcm_util::DecodeError::kNone) continue;
-      (*out)[s.seq] = std::string(static_cast<const char*>(ev->data), static_cast<std::size_t>(ev->datalen));
-      if (largest) *largest = std::max(*largest, static_cast<std::size_t>(ev->datalen));
+      if (ev->channel != channel) continue;
+      const auto size = static_cast<std::size_t>(ev->datalen);
+      Key key;
+      if (sliced) {
+        ladar_slice_t s;
+        if (lcm_util::Decode(ev->data, size, &s) != lcm_util::DecodeError::kNone) continue;
+        key = {s.seq, s.slice_index};
+      } else {
+        ladar_scan_t s;
+        if (lcm_util::Decode(ev->data, size, &s) != lcm_util::DecodeError::kNone) continue;
+        key = {s.seq, 0};
+      }
+      (*out)[key] = std::string(static_cast<const char*>(ev->data), size);
+      if (count) {
+        sweep_bytes[key.first] += size;
+        largest = std::max(largest, size);
+      }
     }
   };
-  read(truth, &want, &largest);
-  read(dir + "/out_" + std::to_string(port) + ".lcm", &got, nullptr);
-  std::printf("logger: %zu of %zu scans recorded, largest %.2f MB\n", got.size(), want.size(), largest / 1e6);
-  EXPECT_GE(want.size(), static_cast<std::size_t>(duration * 10) - 2);
-  EXPECT_GT(largest, 2'000'000u);
+  read(truth, &want, true);
+  read(dir + "/out_" + std::to_string(port) + ".lcm", &got, false);
+  std::size_t sweep_max = 0;
+  for (const auto& [seq, bytes] : sweep_bytes) sweep_max = std::max(sweep_max, bytes);
+  std::printf("logger (%s): %zu of %zu messages recorded, %zu sweeps, largest message %.3f MB, "
+              "largest sweep %.2f MB\n", channel.c_str(), got.size(), want.size(), sweep_bytes.size(),
+              largest / 1e6, sweep_max / 1e6);
+  EXPECT_GE(sweep_bytes.size(), static_cast<std::size_t>(duration * 10) - 2);
+  EXPECT_GT(sweep_max, 2'000'000u);
+  if (sliced) EXPECT_LE(largest, static_cast<std::size_t>(lcm_util::kMaxDatagramMessageBytes));
   EXPECT_EQ(got.size(), want.size());
   int differ = 0;
-  for (const auto& [seq, bytes] : want) differ += !got.count(seq) || got.at(seq) != bytes;
+  for (const auto& [key, bytes] : want) differ += !got.count(key) || got.at(key) != bytes;
   EXPECT_EQ(differ, 0);
   std::filesystem::remove(truth);
   std::filesystem::remove(dir + "/out_" + std::to_string(port) + ".lcm");
+}
+
+TEST(FaultTest, LoggerRecordsEvery2MBScanAt10HzWhileTheTrackerRuns) {
+  VTRACK_REQUIRE_PRIVATE_NETNS();
+  LoggerRecordsEverySweep(/*sliced=*/false);
+}
+
+TEST(FaultTest, LoggerRecordsEverySliceOf2MBSweepsAt10HzWhileTheTrackerRuns) {
+  VTRACK_REQUIRE_PRIVATE_NETNS();
+  LoggerRecordsEverySweep(/*sliced=*/true);
 }
 
 }  // namespace

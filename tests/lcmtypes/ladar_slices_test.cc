@@ -2,6 +2,7 @@
 // sweeps of a rotating multi-layer sensor whose truth is known: every return's column azimuth,
 // and which slice a lost wedge was.
 #include "lcmtypes/util/ladar_slices.h"
+#include "lcmtypes/util/decode.h"
 
 #include <gtest/gtest.h>
 
@@ -310,6 +311,26 @@ TEST(SweepAssemblerTest, BadSlicesAreRefusedByReason) {
   ASSERT_EQ(f.out.size(), 1u);
   ExpectSameScan(f.out[0].scan, scan);
   EXPECT_EQ(f.assembler.slices_accepted(), 4);
+}
+
+// Checked decoding knows the slice's layout: whole slices decode, an inflated npoints or a cut
+// buffer is refused before LCM's decoder allocates.
+TEST(LadarSliceDecodeTest, InflatedOrTruncatedSlicesAreRefused) {
+  const ladar_slice_t s = SliceSweep(MakeSweep(1, 256, 8, 0.0, 1, 12), 4)[1];
+  std::vector<std::uint8_t> buf(static_cast<std::size_t>(s.getEncodedSize()));
+  s.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  ladar_slice_t out;
+  ASSERT_EQ(Decode(buf.data(), buf.size(), &out), DecodeError::kNone);
+  EXPECT_EQ(out.npoints, s.npoints);
+  EXPECT_EQ(out.azimuth_end, s.azimuth_end);
+  // npoints sits just before the arrays: 4 x 4 + 4 + 2 bytes per return after it.
+  const std::size_t npoints_at = buf.size() - static_cast<std::size_t>(s.npoints) * 22 - 4;
+  std::vector<std::uint8_t> inflated = buf;
+  inflated[npoints_at] = 0x7f;  // big-endian: ~2e9 returns
+  std::string why;
+  EXPECT_EQ(Decode(inflated.data(), inflated.size(), &out, &why), DecodeError::kBadLength);
+  EXPECT_NE(why.find("ladar_slice_t.npoints"), std::string::npos) << why;
+  EXPECT_NE(Decode(buf.data(), buf.size() - 3, &out), DecodeError::kNone);
 }
 
 TEST(UncoveredArcsTest, GapsAcrossTheSeamAreMerged) {

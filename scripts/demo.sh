@@ -16,8 +16,8 @@
 #   --mode M          tracker mode: mht | ism | vasm [mht]
 #   --seed N          simulator seed [the scenario's]
 #   --out DIR         where the log, video, PNGs and metrics go [BUILD_DIR/demo/<name>]
-#   --record-scans    also record LADAR_SCAN (64-layer scans: ~1.7 GB per minute; by default
-#                     every channel but LADAR_SCAN is recorded, a few tens of MB)
+#   --record-scans    also record the scans, LADAR_SLICE and LADAR_SCAN (64-layer: ~1.7 GB per
+#                     minute; by default every other channel is recorded, a few tens of MB)
 #   --png-every N     a PNG every N rendered frames [50]
 #   -h, --help        this help
 #
@@ -192,7 +192,7 @@ if [ "$rmem" -lt 4194304 ]; then
 fi
 
 logger_args=(-q -f "--lcm-url=$url&recv_buf_size=8388608")
-[ $record_scans = 1 ] || logger_args+=(-v -c LADAR_SCAN)
+[ $record_scans = 1 ] || logger_args+=(-v -c 'LADAR_SCAN|LADAR_SLICE')
 say "output: $out"
 say "starting lcm-logger, vtrack-tracker ($mode), vtrack-render on $url (private network namespace)"
 start lcm-logger lcm-logger "${logger_args[@]}" "$log"
@@ -286,7 +286,7 @@ fmt() { awk -v v="$1" -v f="$2" 'BEGIN{ if (v == "-" || v == "") print "-"; else
   printf '  %-34s %s\n' "prediction error at 1 s [m]" "$(fmt "${pred1:--}" '%.3f')"
   printf '  %-34s %s\n' "NEES mean (3 = consistent)" "$(fmt "$(json nees_mean)" '%.2f')"
   echo
-  echo "  log      $log$([ $record_scans = 1 ] || echo '  (every channel but LADAR_SCAN; --record-scans for all)')"
+  echo "  log      $log$([ $record_scans = 1 ] || echo '  (every channel but LADAR_SCAN and LADAR_SLICE; --record-scans for all)')"
   echo "  video    $video"
   echo "  PNGs     $pngs/ ($(ls "$pngs" 2>/dev/null | wc -l) files)"
   echo "  metrics  $metrics (and tracks.csv, plots/)"

@@ -50,6 +50,12 @@ LadarScan ScanFromLcm(ladar_scan_t&& msg) {
   return s;
 }
 
+LadarScan ScanFromLcm(lcm_util::AssembledSweep&& sweep) {
+  LadarScan s = ScanFromLcm(std::move(sweep.scan));
+  for (const lcm_util::AzimuthArc& a : sweep.missing) s.lost_wedges.push_back({a.begin, a.end});
+  return s;
+}
+
 DetectionList DetectionsFromLcm(const detection_list_t& msg) {
   DetectionList out;
   out.utime = msg.utime;

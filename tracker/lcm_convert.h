@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "lcmtypes/util/ladar_slices.h"
 #include "tracker/core/scan.h"
 #include "tracker/core/tracker.h"
 #include "vtrack/ladar_scan_t.hpp"
@@ -16,6 +17,8 @@ namespace vtrack {
 
 // Moves the point arrays out of msg (no copy); msg's arrays are left empty.
 LadarScan ScanFromLcm(ladar_scan_t&& msg);
+// A sweep assembled from slices: its scan moved out, its missing arcs as the lost wedges.
+LadarScan ScanFromLcm(lcm_util::AssembledSweep&& sweep);
 // A quaternion within 1e-3 of unit length is normalised; others are passed on as they are and
 // refused by the core as "invalid_pose".
 EgoPose PoseFromLcm(const pose_t& msg);

@@ -57,7 +57,8 @@ constexpr int kPoseQueue = 1000;
 // ~10 KB per sweep) = 75, with margin. Memory bound: 3 s of 64-layer sweeps at 10 Hz are 30 x
 // 2.8 MB = 84 MB; the whole queue, 100 x 2.8 MB = 280 MB, only if the tracker fell 10 s behind.
 constexpr int kScanQueue = 100;
-static_assert(kPoseQueue >= 200 * kStallToAbsorbS && kScanQueue >= 25 * kStallToAbsorbS);
+static_assert(kPoseQueue >= 200 * kStallToAbsorbS && kScanQueue >= 25 * kStallToAbsorbS &&
+              lcm_util::kSliceQueueCapacity >= 45 * 10 * kStallToAbsorbS);
 
 class LiveHandler {
  public:
@@ -82,6 +83,10 @@ int RunLive(const TrackerParams& params, NodeOptions options, const std::string&
                    });
   LiveHandler handler(&node);
   lcm->subscribe(options.scan_channel, &LiveHandler::OnMessage, &handler)->setQueueCapacity(kScanQueue);
+  // A sweep's slices come in a burst of dozens while the previous sweep is processed: LCM's
+  // default queue of 30 messages per subscription would drop the rest of the sweep.
+  lcm->subscribe(options.slice_channel, &LiveHandler::OnMessage, &handler)
+      ->setQueueCapacity(lcm_util::kSliceQueueCapacity);
   lcm->subscribe(options.pose_channel, &LiveHandler::OnMessage, &handler)->setQueueCapacity(kPoseQueue);
   if (params.detections.mode != InputMode::kScans) {
     lcm->subscribe(options.detections_channel, &LiveHandler::OnMessage, &handler)
@@ -111,6 +116,10 @@ int RunLive(const TrackerParams& params, NodeOptions options, const std::string&
                static_cast<long long>(node.tracker().scans_received()),
                static_cast<long long>(node.tracker().scans_processed()),
                static_cast<long long>(node.tracker().scans_dropped()));
+  std::fprintf(stderr, "vtrack-tracker: %lld slices received; %lld returns received, %lld processed\n",
+               static_cast<long long>(node.assembler().slices_accepted()),
+               static_cast<long long>(node.returns_received()),
+               static_cast<long long>(node.tracker().returns_processed()));
   return 0;
 }
 
@@ -194,6 +203,8 @@ int main(int argc, char** argv) {
        "LCM URL for live mode ('' = $LCM_DEFAULT_URL or LCM's default); recv_buf_size=4194304 "
        "is appended to udpm:// URLs that lack it")
       ("scan-channel", po::value(&options.scan_channel)->default_value("LADAR_SCAN"), "input scans")
+      ("slice-channel", po::value(&options.slice_channel)->default_value("LADAR_SLICE"),
+       "input sweeps sent as slices (ladar_slice_t)")
       ("pose-channel", po::value(&options.pose_channel)->default_value("EGO_POSE"), "input ego poses")
       ("detections-channel", po::value(&options.detections_channel)->default_value("DETECTIONS"),
        "input detector boxes (input modes boxes and fused)")

@@ -1,11 +1,13 @@
 #include "tracker/tracker_node.h"
 
 #include <algorithm>
+#include <cmath>
 #include <exception>
 
 #include "lcmtypes/util/decode.h"
 #include "tracker/lcm_convert.h"
 #include "vtrack/ladar_scan_t.hpp"
+#include "vtrack/ladar_slice_t.hpp"
 #include "vtrack/pose_t.hpp"
 
 namespace vtrack {
@@ -44,11 +46,20 @@ void TrackerNode::Handle(const std::string& channel, const void* data, std::size
     if (channel == options_.scan_channel) {
       ladar_scan_t msg;
       if (!DecodeOrCount(channel, data, size, &msg)) return;
+      returns_received_ += msg.npoints;
       NoteArrival(msg.utime);
       tracker_.AddScan(ScanFromLcm(std::move(msg)), &outs_);
+    } else if (channel == options_.slice_channel) {
+      ladar_slice_t msg;
+      if (!DecodeOrCount(channel, data, size, &msg)) return;
+      returns_received_ += msg.npoints;
+      assembler_.Add(std::move(msg), &sweeps_);
+      FeedSweeps();
     } else if (channel == options_.pose_channel) {
       pose_t msg;
       if (!DecodeOrCount(channel, data, size, &msg)) return;
+      assembler_.Expire(msg.utime, &sweeps_);
+      FeedSweeps();
       tracker_.AddPose(PoseFromLcm(msg), &outs_);
     } else if (channel == options_.detections_channel &&
                params_.detections.mode != InputMode::kScans) {
@@ -68,8 +79,18 @@ void TrackerNode::Handle(const std::string& channel, const void* data, std::size
   Warn();
 }
 
+void TrackerNode::FeedSweeps() {
+  for (lcm_util::AssembledSweep& s : sweeps_) {
+    NoteArrival(s.scan.utime);
+    tracker_.AddScan(ScanFromLcm(std::move(s)), &outs_);
+  }
+  sweeps_.clear();
+}
+
 void TrackerNode::Flush() {
   try {
+    assembler_.Flush(&sweeps_);
+    FeedSweeps();
     tracker_.Flush(&outs_);
   } catch (const std::exception& e) {
     ++decode_reasons_["internal_error"];
@@ -137,6 +158,11 @@ tracker_status_t TrackerNode::Status() const {
   s.resets = tracker_.resets();
   std::map<std::string, std::int64_t> reasons = tracker_.rejects();
   for (const auto& [k, v] : decode_reasons_) reasons[k] += v;
+  for (const auto& [k, v] : assembler_.refused()) reasons[k] += v;
+  if (assembler_.slices_lost() > 0) {
+    reasons["slice_lost"] = assembler_.slices_lost();
+    reasons["slice_lost_deg"] = std::llround(assembler_.missing_deg());
+  }
   s.num_reasons = static_cast<int32_t>(reasons.size());
   for (const auto& [k, v] : reasons) {
     s.reject_reason.push_back(k);

@@ -1,5 +1,7 @@
-// The LCM side of vtrack-tracker: decodes LADAR_SCAN and EGO_POSE messages (checked, through
-// lcm_util::Decode), feeds the core Tracker, and hands TRACKS / TRACK_DEBUG / TRACKER_STATUS
+// The LCM side of vtrack-tracker: decodes LADAR_SCAN, LADAR_SLICE and EGO_POSE messages
+// (checked, through lcm_util::Decode), joins slices into sweeps (lcm_util::SweepAssembler: a
+// sweep with lost slices goes on with its lost wedges when the next sweep's slices start, or
+// when the poses pass its end by the assembler's timeout), feeds the core Tracker, and hands TRACKS / TRACK_DEBUG / TRACKER_STATUS
 // messages to a publish function. The same object serves the live bus and the offline log: only
 // the publish function and the status clock differ, so the results cannot depend on how the
 // tracker was fed.
@@ -13,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "lcmtypes/util/ladar_slices.h"
 #include "lcmtypes/util/process.h"
 #include "tracker/core/tracker.h"
 #include "vtrack/tracker_status_t.hpp"
@@ -21,6 +24,7 @@ namespace vtrack {
 
 struct NodeOptions {
   std::string scan_channel = "LADAR_SCAN";
+  std::string slice_channel = "LADAR_SLICE";  // sweeps sent as slices, assembled here
   std::string pose_channel = "EGO_POSE";
   std::string detections_channel = "DETECTIONS";  // read in the input modes boxes and fused
   std::string tracks_channel = "TRACKS";
@@ -52,6 +56,9 @@ class TrackerNode {
   const Tracker& tracker() const { return tracker_; }
   std::int64_t decode_errors() const { return decode_errors_; }
   std::int64_t tracks_published() const { return tracks_published_; }
+  const lcm_util::SweepAssembler& assembler() const { return assembler_; }
+  // Returns in the scans and slices decoded (before any check of the core).
+  std::int64_t returns_received() const { return returns_received_; }
 
  private:
   // Decodes a message (checked); a bad one is counted by reason and warned about.
@@ -60,6 +67,8 @@ class TrackerNode {
   // The wall time a scan or detection list of this utime arrived (for the latency figures).
   void NoteArrival(std::int64_t utime);
   void Emit(std::vector<ScanOutput>* outs);
+  // Hands the sweeps the assembler put together (sweeps_) to the tracker.
+  void FeedSweeps();
   void Warn();
 
   TrackerParams params_;
@@ -70,10 +79,13 @@ class TrackerNode {
   std::map<std::string, std::int64_t> decode_reasons_;
   std::int64_t decode_errors_ = 0;
   std::int64_t tracks_published_ = 0;
+  std::int64_t returns_received_ = 0;
   std::deque<std::pair<std::int64_t, std::int64_t>> arrival_;  // (scan utime, wall utime)
   std::deque<double> latencies_ms_;
   double last_latency_ms_ = 0.0;
   std::vector<ScanOutput> outs_;
+  lcm_util::SweepAssembler assembler_;
+  std::vector<lcm_util::AssembledSweep> sweeps_;
   std::vector<std::uint8_t> buffer_;
   std::int64_t last_tentative_ = 0, last_confirmed_ = 0, last_coasting_ = 0;
 };

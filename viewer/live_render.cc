@@ -27,7 +27,7 @@ LiveRenderer::LiveRenderer(lcm::LCM* lcm, const RenderJob& job, Sink sink,
       router_(job.channels, &assembler_),
       last_message_(std::chrono::steady_clock::now()) {
   if (const std::string err = job_.FirstProblem(); !err.empty()) throw std::invalid_argument(err);
-  for (const std::string* ch : {&job_.channels.scan, &job_.channels.pose, &job_.channels.tracks,
+  for (const std::string* ch : {&job_.channels.scan, &job_.channels.slice, &job_.channels.pose, &job_.channels.tracks,
                                 &job_.channels.debug, &job_.channels.truth}) {
     // LCM subscribes by regular expression: anchor the literal channel name.
     std::string pattern;
@@ -36,6 +36,7 @@ LiveRenderer::LiveRenderer(lcm::LCM* lcm, const RenderJob& job, Sink sink,
       pattern += c;
     }
     subscriptions_.push_back(lcm_->subscribe(pattern, &LiveRenderer::OnMessage, this));
+    if (ch == &job_.channels.slice) subscriptions_.back()->setQueueCapacity(lcm_util::kSliceQueueCapacity);
   }
   render_thread_ = std::thread([this] { RenderLoop(); });
 }
@@ -101,6 +102,7 @@ void LiveRenderer::RenderLoop() {
 void LiveRenderer::Finish() {
   if (finished_) return;
   finished_ = true;
+  router_.Flush();
   Offer(assembler_.Flush());
   slot_.Close();
   if (render_thread_.joinable()) render_thread_.join();

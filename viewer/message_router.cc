@@ -9,7 +9,7 @@ namespace vtrack::viewer {
 
 std::string Channels::FirstProblem() const {
   const std::pair<const char*, const std::string*> all[] = {
-      {"scan_channel", &scan}, {"pose_channel", &pose}, {"tracks_channel", &tracks},
+      {"scan_channel", &scan}, {"slice_channel", &slice}, {"pose_channel", &pose}, {"tracks_channel", &tracks},
       {"debug_channel", &debug}, {"truth_channel", &truth}};
   std::set<std::string> seen;
   for (const auto& [key, value] : all) {
@@ -43,6 +43,18 @@ bool MessageRouter::DecodeInto(const std::string& channel, const void* data, std
   return false;
 }
 
+void MessageRouter::AddSweeps(std::vector<lcm_util::AssembledSweep>* done) {
+  for (lcm_util::AssembledSweep& s : *done) {
+    assembler_->AddScan(std::make_shared<vtrack::ladar_scan_t>(std::move(s.scan)));
+  }
+}
+
+void MessageRouter::Flush() {
+  std::vector<lcm_util::AssembledSweep> done;
+  sweeps_.Flush(&done);
+  AddSweeps(&done);
+}
+
 bool MessageRouter::Route(const std::string& channel, const void* data, std::size_t size) {
   try {
     if (channel == channels_.scan) {
@@ -50,6 +62,13 @@ bool MessageRouter::Route(const std::string& channel, const void* data, std::siz
       if (!DecodeInto(channel, data, size, msg.get())) return false;
       ++received_[channel];
       assembler_->AddScan(std::move(msg));
+    } else if (channel == channels_.slice) {
+      vtrack::ladar_slice_t msg;
+      if (!DecodeInto(channel, data, size, &msg)) return false;
+      ++received_[channel];
+      std::vector<lcm_util::AssembledSweep> done;
+      sweeps_.Add(std::move(msg), &done);
+      AddSweeps(&done);
     } else if (channel == channels_.pose) {
       vtrack::pose_t msg;
       if (!DecodeInto(channel, data, size, &msg)) return false;

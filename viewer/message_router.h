@@ -1,5 +1,6 @@
 // Decodes the messages of the renderer's channels (checked, lcmtypes/util/decode.h) and hands
-// them to a FrameAssembler. Used by both the live bus path and the offline log path. A message
+// them to a FrameAssembler; slices of sweeps are joined into scans first
+// (lcmtypes/util/ladar_slices.h; a partial sweep is drawn with the returns that arrived). Used by both the live bus path and the offline log path. A message
 // that cannot be decoded is counted and reported at a limited rate, never thrown.
 #pragma once
 
@@ -8,6 +9,7 @@
 #include <map>
 #include <string>
 
+#include "lcmtypes/util/ladar_slices.h"
 #include "lcmtypes/util/process.h"
 #include "viewer/frame_assembler.h"
 #include "viewer/validate.h"
@@ -17,6 +19,7 @@ namespace vtrack::viewer {
 // Channel names (docs/design.md, section 1); each is a command-line option of vtrack-render.
 struct Channels {
   std::string scan = "LADAR_SCAN";
+  std::string slice = "LADAR_SLICE";  // sweeps sent as slices (ladar_slice_t), joined into scans
   std::string pose = "EGO_POSE";
   std::string tracks = "TRACKS";
   std::string debug = "TRACK_DEBUG";
@@ -38,6 +41,9 @@ class MessageRouter {
   const std::map<std::string, std::int64_t>& received() const { return received_; }
   const std::map<std::string, std::int64_t>& decode_errors() const { return decode_errors_; }
   std::int64_t total_decode_errors() const;
+  // Hands the sweeps still being assembled from slices to the assembler (end of the input).
+  void Flush();
+  const lcm_util::SweepAssembler& sweeps() const { return sweeps_; }
 
  private:
   template <class T>
@@ -45,6 +51,8 @@ class MessageRouter {
 
   Channels channels_;
   FrameAssembler* assembler_;
+  lcm_util::SweepAssembler sweeps_;  // LADAR_SLICE -> whole or partial scans
+  void AddSweeps(std::vector<lcm_util::AssembledSweep>* done);
   std::map<std::string, std::int64_t> received_;
   std::map<std::string, std::int64_t> decode_errors_;
   lcm_util::RateLimitedLog log_{"vtrack-render", 2.0};

@@ -6,12 +6,14 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <set>
 #include <stdexcept>
 
 #include "lcmtypes/util/decode.h"
 #include "lcmtypes/util/process.h"
 #include "viewer/log_merge.h"
 #include "viewer/scene_builder.h"
+#include "vtrack/ladar_slice_t.hpp"
 #include "vtrack/object_list_t.hpp"
 
 namespace vtrack::viewer {
@@ -93,6 +95,7 @@ std::int64_t LogIndex::Count(const std::string& channel) const {
 LogIndex IndexLogs(const std::vector<std::string>& paths, const Channels& channels,
                    bool progress) {
   LogIndex index;
+  std::set<std::pair<std::string, std::int64_t>> sweeps;  // (sensor, seq) seen on the slice channel
   MergedLogReader reader(paths);
   ProgressBar bar("indexing ", progress);
   const std::int64_t total = std::max<std::int64_t>(1, reader.TotalBytes());
@@ -105,6 +108,11 @@ LogIndex IndexLogs(const std::vector<std::string>& paths, const Channels& channe
       if (lcm_util::Decode(ev->data, size, &scan) == lcm_util::DecodeError::kNone) {
         index.first_scan_utime = scan.utime;
       }
+    } else if (ev->channel == channels.slice) {
+      vtrack::ladar_slice_t slice;
+      if (lcm_util::Decode(ev->data, size, &slice) != lcm_util::DecodeError::kNone) continue;
+      if (index.first_scan_utime < 0) index.first_scan_utime = slice.utime;
+      if (sweeps.insert({slice.sensor_id, slice.seq}).second) ++index.sliced_sweeps;
     } else if (ev->channel == channels.tracks && index.first_tracks_utime < 0) {
       vtrack::track_list_t tracks;
       if (lcm_util::Decode(ev->data, size, &tracks) == lcm_util::DecodeError::kNone) {
@@ -123,7 +131,7 @@ LogIndex IndexLogs(const std::vector<std::string>& paths, const Channels& channe
     bar.Update(static_cast<double>(reader.BytesRead()) / static_cast<double>(total),
                MegaBytes(reader.BytesRead()) + " of " + MegaBytes(total));
   }
-  bar.Done(MegaBytes(total) + ", " + std::to_string(index.Count(channels.scan)) + " scans, " +
+  bar.Done(MegaBytes(total) + ", " + std::to_string(index.Count(channels.scan) + index.sliced_sweeps) + " scans, " +
            std::to_string(index.Count(channels.tracks)) + " track lists");
   return index;
 }
@@ -145,6 +153,7 @@ OfflineStats RenderLogs(const std::vector<std::string>& paths, const RenderJob& 
   const std::string& trigger_channel =
       ap.trigger == AssemblerParams::Trigger::kTracks ? job.channels.tracks : job.channels.scan;
   st.expected_frames = index.Count(trigger_channel);
+  if (ap.trigger != AssemblerParams::Trigger::kTracks) st.expected_frames += index.sliced_sweeps;
   if (st.expected_frames == 0) {
     std::vector<std::string> seen;
     for (const auto& [channel, n] : index.events) seen.push_back(channel + " (" + std::to_string(n) + ")");
@@ -206,7 +215,10 @@ OfflineStats RenderLogs(const std::vector<std::string>& paths, const RenderJob& 
     handle(assembler.TakeReady());
     bar.Update(static_cast<double>(reader.BytesRead()) / total, detail());
   }
-  if (!stop && !lcm_util::StopRequested()) handle(assembler.Flush());
+  if (!stop && !lcm_util::StopRequested()) {
+    router.Flush();
+    handle(assembler.Flush());
+  }
   bar.Done(detail());
 
   st.decode_errors = router.total_decode_errors();

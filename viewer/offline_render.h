@@ -20,6 +20,7 @@ namespace vtrack::viewer {
 struct LogIndex {
   std::map<std::string, std::int64_t> events;   // events per channel (every channel in the logs)
   std::int64_t first_scan_utime = -1;           // [us] utime of the first scan; -1 if none
+  std::int64_t sliced_sweeps = 0;               // sweeps on the slice channel (distinct seq)
   std::int64_t first_tracks_utime = -1;         // [us] of the first TRACKS message; -1 if none
   std::map<std::int64_t, TimedPath> truth_paths;  // [us, m] every true object's path
 

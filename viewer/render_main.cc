@@ -130,6 +130,8 @@ int main(int argc, char** argv) {
        "seconds of data time a frame waits for its debug message, poses and truth")
       ("scan-channel", po::value(&job.channels.scan)->default_value(job.channels.scan),
        "LADAR scans (ladar_scan_t)")
+      ("slice-channel", po::value(&job.channels.slice)->default_value(job.channels.slice),
+       "LADAR sweeps sent as slices (ladar_slice_t), joined into scans")
       ("pose-channel", po::value(&job.channels.pose)->default_value(job.channels.pose),
        "ego pose (pose_t)")
       ("tracks-channel", po::value(&job.channels.tracks)->default_value(job.channels.tracks),

@@ -8,6 +8,7 @@
 #include "vtrack/detection_t.hpp"
 #include "vtrack/hypothesis_t.hpp"
 #include "vtrack/ladar_scan_t.hpp"
+#include "vtrack/ladar_slice_t.hpp"
 #include "vtrack/object_list_t.hpp"
 #include "vtrack/object_t.hpp"
 #include "vtrack/pose_t.hpp"
@@ -138,6 +139,13 @@ bool WalkLadarScan(Walker& w) {
          w.SkipArray(4 * 4 + 4 + 2, "ladar_scan_t.npoints", "ladar_scan_t.points");
 }
 
+bool WalkLadarSlice(Walker& w) {
+  return w.Skip(8 + 8, "ladar_slice_t.utime/seq") && w.SkipString("ladar_slice_t.sensor_id") &&
+         w.Skip(24 + 32 + 4 + 4 + 2, "ladar_slice_t.mounting") &&
+         w.Skip(4 + 4 + 8 + 8, "ladar_slice_t.slice") &&
+         w.SkipArray(4 * 4 + 4 + 2, "ladar_slice_t.npoints", "ladar_slice_t.points");
+}
+
 bool WalkObjectList(Walker& w) {
   return w.Skip(8 + 8, "object_list_t.utime/scan_seq") && w.SkipString("object_list_t.source") &&
          w.SkipArray(FixedSize<object_t>(), "object_list_t.num_objects", "object_list_t.objects");
@@ -199,6 +207,7 @@ struct MessageLayout {
 const std::vector<MessageLayout>& Layouts() {
   static const std::vector<MessageLayout> layouts = {
       {ladar_scan_t::getHash(), WalkLadarScan},
+      {ladar_slice_t::getHash(), WalkLadarSlice},
       {object_list_t::getHash(), WalkObjectList},
       {detection_list_t::getHash(), WalkDetectionList},
       {detection_t::getHash(), WalkFixed<detection_t>},

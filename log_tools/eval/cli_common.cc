@@ -37,6 +37,8 @@ void AddEvalOptions(po::options_description* desc, EvalCliOptions* o) {
     ("pose-channel", po::value(&o->pose_channel)->default_value(o->pose_channel), "ego pose channel")
     ("scan-channel", po::value(&o->scan_channel)->default_value(o->scan_channel),
      "LADAR scan channel (read for the sensor mounting)")
+    ("slice-channel", po::value(&o->slice_channel)->default_value(o->slice_channel),
+     "LADAR slice channel (the same, for sweeps sent as slices)")
     ("kitti-calib", po::value(&o->kitti_calib), "KITTI calibration file (calib/NNNN.txt) for "
                                                 "--region-camera and --kitti-out")
     ("kitti-image-size", po::value(&o->kitti_image_size)->default_value(o->kitti_image_size),
@@ -106,6 +108,7 @@ EvalParams MakeEvalParams(const EvalCliOptions& o) {
   p.tracks_channel = o.tracks_channel;
   p.pose_channel = o.pose_channel;
   p.scan_channel = o.scan_channel;
+  p.slice_channel = o.slice_channel;
   if (o.region_camera) {
     if (o.kitti_calib.empty()) {
       throw std::invalid_argument("--region-camera needs --kitti-calib FILE");

@@ -28,6 +28,7 @@ struct EvalCliOptions {
   std::string tracks_channel = "TRACKS";
   std::string pose_channel = "EGO_POSE";
   std::string scan_channel = "LADAR_SCAN";
+  std::string slice_channel = "LADAR_SLICE";
   std::string kitti_calib;
   std::string kitti_image_size = "1242x375";
   double kitti_sensor_height_m = 1.73;

@@ -15,6 +15,7 @@
 #include "log_tools/eval/gated_assignment.h"
 #include "base/angle.h"
 #include "vtrack/ladar_scan_t.hpp"
+#include "vtrack/ladar_slice_t.hpp"
 #include "vtrack/pose_t.hpp"
 
 namespace vtrack::eval {
@@ -198,6 +199,25 @@ std::string EvalParams::Validate() const {
   return os.str();
 }
 
+namespace {
+
+// The sensor mounting and sweep duration of a scan or a slice of one (the first valid one).
+template <class Msg>
+void TakeMounting(const Msg& msg, LogData* data) {
+  Eigen::Quaterniond q(msg.sensor_orientation[0], msg.sensor_orientation[1],
+                       msg.sensor_orientation[2], msg.sensor_orientation[3]);
+  const Eigen::Vector3d t(msg.sensor_pos[0], msg.sensor_pos[1], msg.sensor_pos[2]);
+  if (t.allFinite() && q.coeffs().allFinite() && q.norm() > 1e-6) {
+    Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
+    m.linear() = q.normalized().toRotationMatrix();
+    m.translation() = t;
+    data->body_from_sensor = m;
+    data->sweep_duration_us = msg.sweep_duration_us;
+  }
+}
+
+}  // namespace
+
 void AddLog(LogData* data, const std::string& path, const EvalParams& params,
             const std::function<void(const std::string&, double)>& progress) {
   data->paths.push_back(path);
@@ -248,16 +268,14 @@ void AddLog(LogData* data, const std::string& path, const EvalParams& params,
         ++data->problems["decode_error_" + params.scan_channel];
         continue;
       }
-      Eigen::Quaterniond q(msg.sensor_orientation[0], msg.sensor_orientation[1],
-                           msg.sensor_orientation[2], msg.sensor_orientation[3]);
-      const Eigen::Vector3d t(msg.sensor_pos[0], msg.sensor_pos[1], msg.sensor_pos[2]);
-      if (t.allFinite() && q.coeffs().allFinite() && q.norm() > 1e-6) {
-        Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
-        m.linear() = q.normalized().toRotationMatrix();
-        m.translation() = t;
-        data->body_from_sensor = m;
-        data->sweep_duration_us = msg.sweep_duration_us;
+      TakeMounting(msg, data);
+    } else if (ev->channel == params.slice_channel && !data->body_from_sensor) {
+      vtrack::ladar_slice_t msg;
+      if (lcm_util::Decode(ev->data, size, &msg, &why) != lcm_util::DecodeError::kNone) {
+        ++data->problems["decode_error_" + params.slice_channel];
+        continue;
       }
+      TakeMounting(msg, data);
     }
   }
   if (progress) progress(path, 1.0);
@@ -329,7 +347,8 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params) {
   if (std::isnan(s.truth_time_offset_s)) {
     if (!data.sweep_duration_us) {
       throw std::runtime_error("the truth time offset 'half the sweep' needs a LADAR_SCAN on channel '" +
-                               params.scan_channel + "' in the logs");
+                               params.scan_channel + "' or a LADAR_SLICE on '" +
+                               params.slice_channel + "' in the logs");
     }
     s.truth_time_offset_s = 0.5e-6 * static_cast<double>(*data.sweep_duration_us);
   }

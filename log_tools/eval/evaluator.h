@@ -67,6 +67,7 @@ struct EvalParams {
   std::string tracks_channel = "TRACKS";       // [-] track_list_t channel
   std::string pose_channel = "EGO_POSE";       // [-] pose_t channel
   std::string scan_channel = "LADAR_SCAN";     // [-] ladar_scan_t channel (sensor mounting only)
+  std::string slice_channel = "LADAR_SLICE";   // [-] ladar_slice_t channel (the same, sliced)
   std::string mode;                 // [-] tracker mode to score ("" = the only one in the logs)
   double gate_m = 2.0;              // [m] CLEAR MOT match gate on the centre distance; > 0
   double hota_gate_m = 2.0;         // [m] HOTA similarity S = max(0, 1 - d / hota_gate_m); > 0

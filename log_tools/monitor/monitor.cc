@@ -13,6 +13,7 @@
 #include "base/pose.h"
 #include "vtrack/hypothesis_t.hpp"
 #include "vtrack/ladar_scan_t.hpp"
+#include "vtrack/ladar_slice_t.hpp"
 #include "vtrack/object_list_t.hpp"
 #include "vtrack/object_t.hpp"
 #include "vtrack/pose_t.hpp"
@@ -39,6 +40,12 @@ bool IsVehicle(std::int8_t c) {
 std::string Summarise(const ladar_scan_t& m) {
   return Format("seq %lld %s: %d pts, %d rings, sweep %.1f ms", LL(m.seq), m.sensor_id.c_str(),
                 m.npoints, m.num_rings, m.sweep_duration_us * 1e-3);
+}
+
+std::string Summarise(const ladar_slice_t& m) {
+  return Format("seq %lld %s: slice %d/%d, azimuth %.1f..%.1f deg, %d pts, %d rings", LL(m.seq),
+                m.sensor_id.c_str(), m.slice_index + 1, m.slice_count, RadToDeg(m.azimuth_begin),
+                RadToDeg(m.azimuth_end), m.npoints, m.num_rings);
 }
 
 std::string Summarise(const pose_t& m) {
@@ -127,7 +134,8 @@ struct KnownType {
 };
 const std::vector<KnownType>& KnownTypes() {
   static const std::vector<KnownType> types = {
-      {ladar_scan_t::getHash(), "ladar_scan_t"},     {pose_t::getHash(), "pose_t"},
+      {ladar_scan_t::getHash(), "ladar_scan_t"},     {ladar_slice_t::getHash(), "ladar_slice_t"},
+      {pose_t::getHash(), "pose_t"},
       {object_list_t::getHash(), "object_list_t"},   {track_list_t::getHash(), "track_list_t"},
       {track_debug_t::getHash(), "track_debug_t"},   {tracker_status_t::getHash(), "tracker_status_t"},
       {object_t::getHash(), "object_t"},             {track_t::getHash(), "track_t"},
@@ -160,6 +168,7 @@ Description Describe(const void* data, std::size_t size) {
   }
   const std::int64_t fp = lcm_util::ReadFingerprint(data, size);
   if (TryDescribe<ladar_scan_t>(data, size, fp, "ladar_scan_t", &d) ||
+      TryDescribe<ladar_slice_t>(data, size, fp, "ladar_slice_t", &d) ||
       TryDescribe<pose_t>(data, size, fp, "pose_t", &d) ||
       TryDescribe<object_list_t>(data, size, fp, "object_list_t", &d) ||
       TryDescribe<track_list_t>(data, size, fp, "track_list_t", &d) ||

@@ -27,9 +27,9 @@ KittiTimeline::KittiTimeline(kitti::SequenceOptions options, lcm::LCM* lcm)
 std::int64_t KittiTimeline::LapUs() const { return seq_->num_frames() * kFrameUs; }
 
 KittiScanTimeline::KittiScanTimeline(kitti::SequenceOptions options, lcm::LCM* lcm,
-                                     std::string scan_channel, std::string truth_channel)
+                                     SweepOutput output, std::string truth_channel)
     : KittiTimeline(std::move(options), lcm),
-      scan_channel_(std::move(scan_channel)),
+      output_(std::move(output)),
       truth_channel_(std::move(truth_channel)) {}
 
 std::int64_t KittiScanTimeline::PublishOffsetUs(int i) const {
@@ -51,9 +51,9 @@ void KittiScanTimeline::Prepare(int i, std::int64_t lap_start_utime, std::int64_
 }
 
 void KittiScanTimeline::Publish() {
-  if (lcm()->publish(scan_channel_, &scan_) < 0) {
-    log_.Warn("publish", "publishing " + scan_channel_ + " failed");
-  }
+  SendSweep(output_, scan_, [&](const std::string& ch, const auto& msg) {
+    if (lcm()->publish(ch, &msg) < 0) log_.Warn("publish", "publishing " + ch + " failed");
+  }, /*paced=*/true);
   if (have_truth_ && lcm()->publish(truth_channel_, &truth_) < 0) {
     log_.Warn("publish_truth", "publishing " + truth_channel_ + " failed");
   }

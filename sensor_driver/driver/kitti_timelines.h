@@ -15,6 +15,7 @@
 
 #include "lcmtypes/util/process.h"
 #include "sensor_driver/driver/realtime.h"
+#include "sensor_driver/sim/sweep_output.h"
 #include "sensor_driver/kitti/kitti_sequence.h"
 
 namespace vtrack::sim {
@@ -43,7 +44,7 @@ class KittiTimeline : public Timeline {
 class KittiScanTimeline : public KittiTimeline {
  public:
   // Throws kitti::KittiError for a missing or malformed sequence.
-  KittiScanTimeline(kitti::SequenceOptions options, lcm::LCM* lcm, std::string scan_channel,
+  KittiScanTimeline(kitti::SequenceOptions options, lcm::LCM* lcm, SweepOutput output,
                     std::string truth_channel /* "" = no ground truth */);
   int Count() const override { return seq().num_frames(); }
   std::int64_t PublishOffsetUs(int i) const override;
@@ -51,7 +52,8 @@ class KittiScanTimeline : public KittiTimeline {
   void Publish() override;
 
  private:
-  std::string scan_channel_, truth_channel_;
+  SweepOutput output_;
+  std::string truth_channel_;
   vtrack::ladar_scan_t scan_;
   vtrack::object_list_t truth_;
   bool have_truth_ = false;

@@ -1,4 +1,4 @@
-// vtrack-ladar-driver: publishes LADAR_SCAN and GROUND_TRUTH live, from a simulated scenario or
+// vtrack-ladar-driver: publishes LADAR_SLICE (3-D sweeps, --slices) or LADAR_SCAN and GROUND_TRUTH live, from a simulated scenario or
 // a replayed KITTI tracking sequence. Time: realtime.h (shared with vtrack-ego-pose).
 #include <boost/program_options.hpp>
 
@@ -21,8 +21,8 @@ int main(int argc, char** argv) {
   vtrack::sim::AddLiveSourceOptions(
       &desc, vtrack::sim::AddSensorOptions,
       "replay a KITTI tracking sequence from DIR instead of a scenario");
+  vtrack::sim::AddSweepOutputOptions(&desc, /*live=*/true);
   desc.add_options()
-      ("scan-channel", po::value<std::string>()->default_value("LADAR_SCAN"), "channel of the scans")
       ("truth-channel", po::value<std::string>()->default_value("GROUND_TRUTH"), "channel of the ground truth")
       ("no-truth", "do not publish ground truth");
   vtrack::sim::AddLiveRunOptions(&desc);
@@ -38,14 +38,20 @@ int main(int argc, char** argv) {
           vtrack::sim::ParseLiveCommandLine(argc, argv, desc, usage, name, &vm, &cli)) {
     return *status;
   }
-  const std::string scan_channel = vm["scan-channel"].as<std::string>();
+  vtrack::sim::SweepOutput output;
+  try {
+    output = vtrack::sim::ReadSweepOutputOptions(vm);
+  } catch (const po::error& e) {
+    std::fprintf(stderr, "%s: %s (see --help)\n", name, e.what());
+    return 2;
+  }
   const std::string truth_channel =
       vm.count("no-truth") ? "" : vm["truth-channel"].as<std::string>();
   vtrack::sim::LiveSource source;
 #ifdef VTRACK_HAVE_KITTI
   source.kitti = [&](lcm::LCM* lcm) {
     auto t = std::make_unique<vtrack::sim::KittiScanTimeline>(
-        vtrack::sim::KittiCliOptions(vm), lcm, scan_channel, truth_channel);
+        vtrack::sim::KittiCliOptions(vm), lcm, output, truth_channel);
     std::fprintf(stderr, "vtrack-ladar-driver: KITTI sequence %s, %d frames\n",
                  vm["sequence"].as<std::string>().c_str(), t->Count());
     return t;
@@ -58,7 +64,7 @@ int main(int argc, char** argv) {
                  sim->scenario().name.c_str(), sim->sensor().name.c_str(),
                  sim->sensor().NumLayers(), sim->sensor().rate_hz, sim->sensor().NumColumns(),
                  static_cast<unsigned long long>(sim->seed()), sim->NumScans());
-    return std::make_unique<vtrack::sim::SimScanTimeline>(sim, lcm, scan_channel, truth_channel);
+    return std::make_unique<vtrack::sim::SimScanTimeline>(sim, lcm, output, truth_channel);
   };
   return vtrack::sim::RunLive(vm, cli, name, "scans", source);
 }

@@ -22,9 +22,9 @@ int main(int argc, char** argv) {
   vtrack::sim::AddScenarioOptions(&desc, /*start_utime_is_live=*/false);
   vtrack::sim::AddSensorOptions(&desc);
   vtrack::sim::AddPoseOptions(&desc);
+  vtrack::sim::AddSweepOutputOptions(&desc, /*live=*/false);
   desc.add_options()
       ("out,o", po::value<std::string>(), "LCM log file to write (overwritten)")
-      ("scan-channel", po::value<std::string>()->default_value("LADAR_SCAN"), "channel of the scans")
       ("truth-channel", po::value<std::string>()->default_value("GROUND_TRUTH"), "channel of the ground truth")
       ("pose-channel", po::value<std::string>()->default_value("EGO_POSE"), "channel of the ego poses")
       ("describe", "print the scenario's objects and each vehicle's path instead of writing a log")
@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   auto check = [](const po::variables_map& vm) {
     if (!vm.count("scenario")) throw po::error("--scenario is required");
     if (!vm.count("out") && !vm.count("describe")) throw po::error("--out is required");
+    vtrack::sim::ReadSweepOutputOptions(vm);
   };
   po::variables_map vm;
   vtrack::sim::SimCli cli;
@@ -54,7 +55,7 @@ int main(int argc, char** argv) {
     const std::string out = vm["out"].as<std::string>();
     const std::int64_t start = cli.start_utime.value_or(sim->scenario().start_utime);
     SimLogChannels ch;
-    ch.scan = vm["scan-channel"].as<std::string>();
+    ch.sweep = vtrack::sim::ReadSweepOutputOptions(vm);
     ch.truth = vm["truth-channel"].as<std::string>();
     ch.pose = vm["pose-channel"].as<std::string>();
     if (!quiet) {
@@ -83,11 +84,12 @@ int main(int argc, char** argv) {
     if (!quiet) {
       const double run = sim->RunDurationUs() * 1e-6;
       std::fprintf(stderr,
-                   "vtrack-sim-log: wrote %s: %d scans (%.0f points/scan), %d ground-truth lists, "
-                   "%d poses, %.1f MB; %.1f s of scenario in %.2f s wall = %.1fx real time "
-                   "(%.2f s CPU = %.1fx)\n",
+                   "vtrack-sim-log: wrote %s: %d scans (%.0f points/scan, %lld slices), %d "
+                   "ground-truth lists, %d poses, %.1f MB; %.1f s of scenario in %.2f s wall = "
+                   "%.1fx real time (%.2f s CPU = %.1fx)\n",
                    out.c_str(), stats.scans,
                    stats.scans ? static_cast<double>(stats.points) / stats.scans : 0.0,
+                   static_cast<long long>(stats.slices),
                    stats.scans, stats.poses, stats.bytes / 1e6, run, wall, run / wall, cpu,
                    cpu > 0 ? run / cpu : 0.0);
     }

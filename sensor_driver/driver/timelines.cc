@@ -2,9 +2,9 @@
 
 namespace vtrack::sim {
 
-SimScanTimeline::SimScanTimeline(Simulator* sim, lcm::LCM* lcm, std::string scan_channel,
+SimScanTimeline::SimScanTimeline(Simulator* sim, lcm::LCM* lcm, SweepOutput output,
                                  std::string truth_channel)
-    : sim_(sim), lcm_(lcm), scan_channel_(std::move(scan_channel)),
+    : sim_(sim), lcm_(lcm), output_(std::move(output)),
       truth_channel_(std::move(truth_channel)) {}
 
 void SimScanTimeline::Prepare(int i, std::int64_t lap_start_utime, std::int64_t lap) {
@@ -12,9 +12,9 @@ void SimScanTimeline::Prepare(int i, std::int64_t lap_start_utime, std::int64_t 
 }
 
 void SimScanTimeline::Publish() {
-  if (lcm_->publish(scan_channel_, &scan_) < 0) {
-    log_.Warn("publish", "publishing " + scan_channel_ + " failed");
-  }
+  slices_ += SendSweep(output_, scan_, [&](const std::string& ch, const auto& msg) {
+    if (lcm_->publish(ch, &msg) < 0) log_.Warn("publish", "publishing " + ch + " failed");
+  }, /*paced=*/true);
   points_ += scan_.npoints;
   if (!truth_channel_.empty() && lcm_->publish(truth_channel_, &truth_) < 0) {
     log_.Warn("publish_truth", "publishing " + truth_channel_ + " failed");

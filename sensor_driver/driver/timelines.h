@@ -9,13 +9,14 @@
 #include "lcmtypes/util/process.h"
 #include "sensor_driver/driver/realtime.h"
 #include "sensor_driver/sim/simulator.h"
+#include "sensor_driver/sim/sweep_output.h"
 
 namespace vtrack::sim {
 
-// LADAR_SCAN + GROUND_TRUTH of a scenario. seq = lap * NumScans() + i.
+// LADAR_SCAN or LADAR_SLICE (output) + GROUND_TRUTH of a scenario. seq = lap * NumScans() + i.
 class SimScanTimeline : public Timeline {
  public:
-  SimScanTimeline(Simulator* sim, lcm::LCM* lcm, std::string scan_channel,
+  SimScanTimeline(Simulator* sim, lcm::LCM* lcm, SweepOutput output,
                   std::string truth_channel /* "" = do not publish ground truth */);
   int Count() const override { return sim_->NumScans(); }
   std::int64_t LapUs() const override { return sim_->RunDurationUs(); }
@@ -23,14 +24,16 @@ class SimScanTimeline : public Timeline {
   void Prepare(int i, std::int64_t lap_start_utime, std::int64_t lap) override;
   void Publish() override;
   std::int64_t points_published() const { return points_; }
+  std::int64_t slices_published() const { return slices_; }
 
  private:
   Simulator* sim_;
   lcm::LCM* lcm_;
-  std::string scan_channel_, truth_channel_;
+  SweepOutput output_;
+  std::string truth_channel_;
   vtrack::ladar_scan_t scan_;
   vtrack::object_list_t truth_;
-  std::int64_t points_ = 0;
+  std::int64_t points_ = 0, slices_ = 0;
   lcm_util::RateLimitedLog log_{"vtrack-ladar-driver"};
 };
 

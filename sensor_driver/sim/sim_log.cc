@@ -22,9 +22,12 @@ SimLogStats WriteSimLog(Simulator& sim, std::int64_t start_utime, const SimLogCh
     } else {
       sim.MakeScan(i, start_utime, i, &scan, &truth);
       const std::int64_t ts = start_utime + sim.ScanPublishOffsetUs(i);
-      writer->WriteMessage(ts, channels.scan, scan);
+      stats.slices += SendSweep(channels.sweep, scan, [&](const std::string& ch, const auto& msg) {
+        writer->WriteMessage(ts, ch, msg);
+        stats.bytes += msg.getEncodedSize();
+      });
       writer->WriteMessage(ts, channels.truth, truth);
-      stats.bytes += scan.getEncodedSize() + truth.getEncodedSize();
+      stats.bytes += truth.getEncodedSize();
       stats.points += scan.npoints;
       ++i;
       if (progress && (i % 20 == 0 || i == n_scans)) progress(static_cast<double>(i) / n_scans);

@@ -1,8 +1,8 @@
 // Writing a scenario's whole run straight to an LCM log file, as fast as the machine allows, with
 // what lcm-logger would have recorded from a live run of vtrack-ladar-driver + vtrack-ego-pose
 // started with the same --start-utime: the same messages, in the order they are published, with
-// event timestamps at the instant of publication (pose: its utime; scan and its ground truth:
-// when the sweep is complete, utime + sweep_duration_us). A live log differs only by the
+// event timestamps at the instant of publication (pose: its utime; scan, or all its slices, and
+// its ground truth: when the sweep is complete, utime + sweep_duration_us). A live log differs only by the
 // network and scheduling jitter in lcm-logger's receive timestamps.
 #pragma once
 
@@ -12,17 +12,19 @@
 
 #include "lcmtypes/util/log_reader.h"
 #include "sensor_driver/sim/simulator.h"
+#include "sensor_driver/sim/sweep_output.h"
 
 namespace vtrack::sim {
 
 struct SimLogChannels {
-  std::string scan = "LADAR_SCAN";
+  SweepOutput sweep;  // whole sweeps or slices (sweep_output.h)
   std::string truth = "GROUND_TRUTH";
   std::string pose = "EGO_POSE";
 };
 
 struct SimLogStats {
   int scans = 0;
+  std::int64_t slices = 0;  // slice messages (0: every sweep written whole)
   int poses = 0;
   std::int64_t points = 0;  // returns over all scans
   std::int64_t bytes = 0;   // encoded message bytes

@@ -55,7 +55,8 @@ TEST(KittiReplayTest, DriverAndEgoPosePublishTheSequenceOnTheRunClock) {
                                         "--rate", std::to_string(rate), "--lcm-url", kTestBusUrl,
                                         "-q"};
   const std::string log = dir + "/live.lcm";
-  testing::RecordDriverAndEgoPose(dir, common, kLoggerUrl, log, 60000ms, 700ms);
+  // Whole sweeps (--slices 0): the bytes of each must be the converter's ladar_scan_t.
+  testing::RecordDriverAndEgoPose(dir, common, kLoggerUrl, log, 60000ms, 700ms, {"--slices", "0"});
   ASSERT_FALSE(HasFatalFailure());
   const std::int64_t shift = start - seq.ScanUtime(0);
   int scans = 0, truths = 0, poses = 0;

@@ -30,10 +30,12 @@ void StopLogger(Subprocess* logger, std::chrono::milliseconds flush) {
 
 void RecordDriverAndEgoPose(const std::string& dir, const std::vector<std::string>& common,
                             const std::string& logger_url, const std::string& log,
-                            std::chrono::milliseconds limit, std::chrono::milliseconds flush) {
+                            std::chrono::milliseconds limit, std::chrono::milliseconds flush,
+                            const std::vector<std::string>& driver_only) {
   Subprocess logger({"lcm-logger", "-q", "-f", "--lcm-url=" + logger_url, log}, dir + "/logger.txt");
   std::vector<std::string> d{BinDir() + "/vtrack-ladar-driver"}, e{BinDir() + "/vtrack-ego-pose"};
   d.insert(d.end(), common.begin(), common.end());
+  d.insert(d.end(), driver_only.begin(), driver_only.end());
   e.insert(e.end(), common.begin(), common.end());
   Subprocess driver(d, dir + "/driver.txt");
   Subprocess ego(e, dir + "/ego.txt");

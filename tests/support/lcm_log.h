@@ -32,9 +32,10 @@ void StopLogger(Subprocess* logger, std::chrono::milliseconds flush);
 // vtrack-ladar-driver and vtrack-ego-pose (from BinDir()) run with the same options `common` while
 // lcm-logger, on logger_url, records into `log`; both must end within `limit` with status 0, then
 // the logger is stopped (StopLogger). Outputs go to dir/driver.txt, dir/ego.txt, dir/logger.txt.
-// Failures are fatal: callers check HasFatalFailure().
+// Failures are fatal: callers check HasFatalFailure(). driver_only: options for the driver alone.
 void RecordDriverAndEgoPose(const std::string& dir, const std::vector<std::string>& common,
                             const std::string& logger_url, const std::string& log,
-                            std::chrono::milliseconds limit, std::chrono::milliseconds flush);
+                            std::chrono::milliseconds limit, std::chrono::milliseconds flush,
+                            const std::vector<std::string>& driver_only = {});
 
 }  // namespace vtrack::testing

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "lcmtypes/util/ladar_slices.h"
 #include "lcmtypes/util/log_reader.h"
 #include "tests/support/subprocess.h"
 #include "tests/support/test_env.h"
@@ -51,6 +52,7 @@ struct LogSpec {
   bool tracks = true;
   bool split = false;          // scans/poses/truth in one log, tracks/debug in another
   bool garbage_tracks = false; // one undecodable TRACKS message
+  int slices = 0;              // > 0: each scan written as that many LADAR_SLICE messages
 };
 
 // Writes the log(s) and returns their paths.
@@ -70,7 +72,14 @@ std::vector<std::string> WriteLogs(const std::string& dir, const LogSpec& spec) 
     const std::int64_t t = ego.t0 + k * kPeriod;
     for (std::int64_t p = t; p < t + kPeriod; p += 20'000) sim.WriteMessage(p, "EGO_POSE", ego.Pose(p));
     // The scan is published when the sweep ends; the tracker answers a few ms later.
-    sim.WriteMessage(t + kPeriod, "LADAR_SCAN", testing::ScanOf(ego, t, k, wall, dt));
+    const ladar_scan_t scan = testing::ScanOf(ego, t, k, wall, dt);
+    if (spec.slices > 0) {
+      for (const ladar_slice_t& s : lcm_util::SliceSweep(scan, spec.slices)) {
+        sim.WriteMessage(t + kPeriod, "LADAR_SLICE", s);
+      }
+    } else {
+      sim.WriteMessage(t + kPeriod, "LADAR_SCAN", scan);
+    }
     sim.WriteMessage(t + kPeriod, "GROUND_TRUTH",
                      testing::TruthAt(t, k, 77, CarAt(k).x() + 0.2, CarAt(k).y(), 0.0));
     if (!spec.tracks) continue;
@@ -173,6 +182,32 @@ TEST(RenderLogTest, ScansOnlyLogGivesOneFramePerScan) {
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(DecodedFrames(dir + "/scans.mp4"), 12);
   EXPECT_NE(r.output.find("one per LADAR_SCAN"), std::string::npos) << r.output;
+}
+
+// The same scans sent as slices: the renderer joins them and draws the same frames, pixel for
+// pixel, as from the whole scans.
+TEST(RenderLogTest, SlicedScansDrawTheFramesOfWholeScans) {
+  const std::string dir = ScratchDir("render-log-sliced");
+  fs::create_directories(dir + "/whole");
+  fs::create_directories(dir + "/sliced");
+  const auto whole = WriteLogs(dir + "/whole", {.scans = 12, .tracks = false});
+  const auto sliced = WriteLogs(dir + "/sliced", {.scans = 12, .tracks = false, .slices = 4});
+  for (const auto& [logs, sub] : {std::pair{whole, "/whole"}, std::pair{sliced, "/sliced"}}) {
+    const auto r = Render(dir, Cat(Cat(Inputs(logs), kWindow),
+                                   {"--video", dir + sub + "/v.mp4", "--png-dir", dir + sub + "/png",
+                                    "--png-every", "1", "--quiet"}));
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(DecodedFrames(dir + sub + "/v.mp4"), 12) << sub;
+  }
+  ASSERT_EQ(CountPngs(dir + "/sliced/png"), 12u);
+  for (int k = 0; k < 12; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "/png/frame_%06d.png", k);
+    const cv::Mat a = cv::imread(dir + "/whole" + name), b = cv::imread(dir + "/sliced" + name);
+    ASSERT_FALSE(a.empty()) << name;
+    ASSERT_FALSE(b.empty()) << name;
+    EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0) << name;
+  }
 }
 
 TEST(RenderLogTest, UndecodableMessageIsCountedAndSkipped) {

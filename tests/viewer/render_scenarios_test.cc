@@ -12,7 +12,9 @@
 #include <string>
 #include <vector>
 
+#include "lcmtypes/util/decode.h"
 #include "lcmtypes/util/log_reader.h"
+#include "vtrack/ladar_slice_t.hpp"
 #include "tests/support/subprocess.h"
 #include "tests/support/test_env.h"
 
@@ -26,10 +28,21 @@ using vtrack::testing::RunCommand;
 using vtrack::testing::ScratchDir;
 using vtrack::testing::SourceDir;
 
+// Events per channel; "sweeps": scans whole (LADAR_SCAN) or sent as slices (LADAR_SLICE, one
+// sweep per slice 0).
 std::map<std::string, int> CountEvents(const std::string& path) {
   std::map<std::string, int> n;
   lcm_util::LogReader r(path);
-  while (const auto* ev = r.Next()) ++n[ev->channel];
+  while (const auto* ev = r.Next()) {
+    ++n[ev->channel];
+    if (ev->channel == "LADAR_SCAN") ++n["sweeps"];
+    vtrack::ladar_slice_t s;
+    if (ev->channel == "LADAR_SLICE" &&
+        lcm_util::Decode(ev->data, static_cast<std::size_t>(ev->datalen), &s) == lcm_util::DecodeError::kNone &&
+        s.slice_index == 0) {
+      ++n["sweeps"];
+    }
+  }
   return n;
 }
 
@@ -81,7 +94,7 @@ TEST_P(RenderScenarioTest, VideoHasOneFramePerScan) {
 
   const auto sim_events = CountEvents(run);
   const auto trk_events = CountEvents(tracks);
-  const int scans = sim_events.count("LADAR_SCAN") ? sim_events.at("LADAR_SCAN") : 0;
+  const int scans = sim_events.count("sweeps") ? sim_events.at("sweeps") : 0;
   const int lists = trk_events.count("TRACKS") ? trk_events.at("TRACKS") : 0;
   ASSERT_GT(scans, 0);
   EXPECT_GT(trk_events.count("TRACK_DEBUG") ? trk_events.at("TRACK_DEBUG") : 0, 0);

@@ -58,6 +58,19 @@ int RangeProfile::Bin(const Eigen::Vector2d& p) const {
   return ((b % n) + n) % n;
 }
 
+void RangeProfile::MarkUnseen(double begin, double end) {
+  const int n = num_bins_;
+  if (n == 0) return;
+  const int first = static_cast<int>(std::floor((WrapToPi(begin) + kPi) * inv_bin_));
+  const int count = std::min(n, static_cast<int>(std::ceil((end - begin) * inv_bin_)) + 1);
+  for (int k = 0; k < count; ++k) {
+    const int b = (((first + k) % n) + n) % n;
+    for (int r = 0; r < num_rings_; ++r) {
+      nearest_[static_cast<std::size_t>(r) * static_cast<std::size_t>(n) + static_cast<std::size_t>(b)] = 0.0f;
+    }
+  }
+}
+
 bool RangeProfile::FreeBeyond(const Eigen::Vector2d& end, const Eigen::Vector2d& inner,
                               double margin, int bins) const {
   if (nearest_.empty()) return false;

@@ -29,6 +29,10 @@ class RangeProfile {
   // it); on every ring if none does.
   bool FreeBeyond(const Eigen::Vector2d& end, const Eigen::Vector2d& inner, double margin,
                   int bins) const;
+  // Marks the bins of world bearings from begin to end [rad] (counter-clockwise) as hidden on
+  // every ring (a return at range 0): where the sweep's returns were lost, a face's end is not
+  // seen, and the face must not be taken for a full view.
+  void MarkUnseen(double begin, double end);
   bool empty() const { return nearest_.empty(); }
 
   static constexpr int kMaxRings = 256;

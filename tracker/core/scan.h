@@ -5,11 +5,26 @@
 
 #include <Eigen/Geometry>
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "base/angle.h"
+
 namespace vtrack {
+
+// An arc of the sensor's azimuth, counter-clockwise from begin to end [rad], sensor frame
+// (begin in [-pi, pi), begin < end <= begin + 2 pi).
+struct AzimuthWedge {
+  double begin = 0.0;
+  double end = 0.0;
+  bool Contains(double azimuth) const {
+    double d = std::fmod(azimuth - begin, 2.0 * kPi);  // turned from begin, in [0, 2 pi)
+    if (d < 0.0) d += 2.0 * kPi;
+    return d <= end - begin;
+  }
+};
 
 // One sweep of a scanning LADAR as parallel arrays (structure of arrays). Point i is at
 // (x[i], y[i], z[i]) in the sensor frame and was measured at utime + dt_us[i].
@@ -26,6 +41,11 @@ struct LadarScan {
   std::vector<float> intensity;       // [-]
   std::vector<std::int32_t> dt_us;    // [us] time after utime
   std::vector<std::int16_t> ring;     // [-] laser/layer index
+
+  // Wedges of the sweep whose returns were lost on the way (a sweep sent as slices, some of which
+  // did not arrive; lcmtypes/util/ladar_slices.h). A track predicted inside one is not observed
+  // by this sweep: it is not counted as missed. Empty for a whole sweep.
+  std::vector<AzimuthWedge> lost_wedges;
 
   std::size_t size() const { return x.size(); }
   // Time of the last return this sweep can hold: the scan is complete in time once the pose

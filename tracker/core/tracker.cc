@@ -107,6 +107,7 @@ void Tracker::ProcessReady(bool flush, std::vector<ScanOutput>* out) {
       continue;
     }
     const bool processed = Process(*scan, scan_extrapolate, &o);
+    if (processed) returns_processed_ += static_cast<std::int64_t>(scan->size());
     if (processed) out->push_back(std::move(o));
     sequencer_.Done(processed);
   }
@@ -161,6 +162,7 @@ bool Tracker::Process(const LadarScan& scan, bool extrapolate, ScanOutput* out) 
   // Association with the tracks predicted to the middle of the sweep.
   manager_->Predict(scan.utime + scan.sweep_duration_us / 2, &predicted_);
   associator_.Run(predicted_, points_, segments_, pre.sensor_xy, &association_);
+  MarkUnobserved(scan, extrapolate);
   // Each track updated with its returns; new tracks from what is left; life cycle; report.
   UpdateTracks(scan, pre.sensor_xy, out);
   CreateTracks(scan, pre.sensor_xy);
@@ -196,6 +198,42 @@ bool Tracker::Preprocess(const LadarScan& scan, bool extrapolate, PreprocessResu
   return true;
 }
 
+void Tracker::MarkUnobserved(const LadarScan& scan, bool extrapolate) {
+  unobserved_.assign(predicted_.size(), 0);
+  lost_world_.clear();
+  if (scan.lost_wedges.empty()) return;
+  const std::int64_t mid = scan.utime + scan.sweep_duration_us / 2;
+  const std::optional<Eigen::Isometry3d> world_from_body =
+      sequencer_.poses().At(mid, extrapolate ? params_.input.max_extrapolation_us : 0);
+  if (!world_from_body) return;  // Preprocess placed the sweep, so this does not happen
+  const Eigen::Isometry3d sensor_from_world = (*world_from_body * scan.body_from_sensor).inverse();
+  // Lost wedges in world bearings (level sensor: its yaw) hide faces' ends (UpdateTracks).
+  const Eigen::Isometry3d world_from_sensor = *world_from_body * scan.body_from_sensor;
+  const double sensor_z = world_from_sensor.translation().z();
+  const double yaw = std::atan2(world_from_sensor.linear()(1, 0), world_from_sensor.linear()(0, 0));
+  for (const AzimuthWedge& w : scan.lost_wedges) lost_world_.push_back({w.begin + yaw, w.end + yaw});
+  std::int64_t unobserved = 0;
+  for (std::size_t j = 0; j < predicted_.size(); ++j) {
+    const Eigen::Vector2d& c = predicted_[j].box.center;
+    const Eigen::Vector3d p = sensor_from_world * Eigen::Vector3d(c.x(), c.y(), sensor_z);
+    const double azimuth = std::atan2(p.y(), p.x());
+    for (const AzimuthWedge& w : scan.lost_wedges) {
+      if (w.Contains(azimuth)) {
+        unobserved_[j] = 1;
+        ++unobserved;
+        break;
+      }
+    }
+  }
+  rejects_.Count("sweep_partial", 1,
+                 "scan " + Str(scan.seq) + " at " + Str(scan.utime) + ": " +
+                     Str(static_cast<std::int64_t>(scan.lost_wedges.size())) +
+                     " wedges lost on the way, processed without them");
+  rejects_.Count("track_in_lost_wedge", unobserved,
+                 "scan " + Str(scan.seq) + ": " + Str(unobserved) +
+                     " tracks in lost wedges not counted as missed");
+}
+
 void Tracker::UpdateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_xy,
                            ScanOutput* out) {
   // 3-D clouds only: a single-plane scanner's bearing spacing (0.5 deg or more) leaves bins of
@@ -204,6 +242,7 @@ void Tracker::UpdateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_
   if (multi_ring) {
     profile_.Build(sensor_xy, points_.x, points_.y, points_.ring,
                    std::max(kMinProfileBinDeg, params_.outline.bin_deg));
+    for (const AzimuthWedge& w : lost_world_) profile_.MarkUnseen(w.begin, w.end);
   }
   const std::size_t num_tracks = manager_->tracks().size();
   // Fused: a track a box of this frame has updated (the frame's list is processed before its
@@ -216,7 +255,7 @@ void Tracker::UpdateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_
     const auto& idx = association_.track_points[j];
     if (fused && manager_->tracks()[j].last_box_utime >= scan.utime) continue;
     if (idx.empty()) {
-      manager_->Miss(j);
+      if (!unobserved_[j]) manager_->Miss(j);
       continue;
     }
     outline_.Extract(points_, idx, scan, sensor_xy, &point_set_);

@@ -10,6 +10,10 @@
 // OrderNewObjects' order, a piece of a rectangle created from this scan merged into it -> life
 // cycle -> report at the scan's utime (the time of the ground truth and of track_list_t.utime).
 //
+// A sweep with lost wedges (LadarScan::lost_wedges) is processed with the returns it has; a
+// track whose predicted centre lies in a lost wedge gets no miss from it (as a track nobody
+// looked at), counted as track_in_lost_wedge; the sweep is counted as sweep_partial.
+//
 // Bad input is dropped and counted by reason (rejects(); the keys are listed in
 // tracker/README.md and docs/reliability.md). A message more than time_jump_reset_us older than the newest one (a
 // looped log) resets the tracker: tracks, poses and queue are cleared, ids continue.
@@ -66,6 +70,7 @@ class Tracker {
   // Counters since construction.
   std::int64_t scans_received() const { return sequencer_.scans_received(); }
   std::int64_t scans_processed() const { return sequencer_.scans_processed(); }
+  std::int64_t returns_processed() const { return returns_processed_; }  // in processed scans
   std::int64_t scans_dropped() const { return sequencer_.scans_dropped(); }
   std::int64_t poses_received() const { return sequencer_.poses_received(); }
   std::int64_t resets() const { return sequencer_.resets(); }
@@ -91,7 +96,10 @@ class Tracker {
   bool ProcessDetections(const DetectionList& list, bool extrapolate, ScanOutput* out);
   // Compensation and ground; false (counted) if no pose covers the sweep.
   bool Preprocess(const LadarScan& scan, bool extrapolate, PreprocessResult* pre);
-  // Updates every track with its returns (a miss if none).
+  // Marks in unobserved_ the tracks whose centre predicted to mid-sweep (predicted_) lies in a
+  // lost wedge of the sweep, seen from the sensor at mid-sweep; counts them and the sweep.
+  void MarkUnobserved(const LadarScan& scan, bool extrapolate);
+  // Updates every track with its returns (a miss if none, unless it was not observed).
   void UpdateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_xy, ScanOutput* out);
   // New tracks from the objects association left over.
   void CreateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_xy);
@@ -115,6 +123,9 @@ class Tracker {
   AssociationResult association_;
   PointSet point_set_;
   RangeProfile profile_;  // nearest return per bearing of the scan being processed
+  std::vector<char> unobserved_;  // per track: in a lost wedge of the scan being processed
+  std::vector<AzimuthWedge> lost_world_;  // the scan's lost wedges as world bearings [rad]
+  std::int64_t returns_processed_ = 0;
 };
 
 }  // namespace vtrack

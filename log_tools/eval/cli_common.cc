@@ -13,7 +13,7 @@ namespace vtrack::eval {
 
 void AddEvalOptions(po::options_description* desc, EvalCliOptions* o) {
   desc->add_options()
-    ("mode", po::value(&o->mode), "tracker mode whose TRACKS to score (ism, vasm, mht); "
+    ("mode", po::value(&o->mode), "tracker mode whose TRACKS to score (cv, ism, vasm, mht); "
                                   "default: the only one in the logs")
     ("gate", po::value(&o->gate_m)->default_value(o->gate_m),
      "[m] CLEAR MOT match gate on the centre distance")

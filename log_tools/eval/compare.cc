@@ -101,6 +101,12 @@ void RunProcess(const std::vector<std::string>& argv, const std::string& log_pat
                            ") ends:\n" + Tail(log_path, 15));
 }
 
+std::string JoinComma(const std::vector<std::string>& v) {
+  std::string out;
+  for (const auto& s : v) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
 std::string DefaultBinDir() {
   std::error_code ec;
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
@@ -212,8 +218,8 @@ int RunCompare(const CompareOptions& o) {
   }
   if (o.modes.empty()) throw std::invalid_argument("--modes is empty");
   for (const auto& m : o.modes) {
-    if (m != "ism" && m != "vasm" && m != "mht") {
-      throw std::invalid_argument("--modes: unknown mode '" + m + "' (ism, vasm, mht)");
+    if (m != "cv" && m != "ism" && m != "vasm" && m != "mht") {
+      throw std::invalid_argument("--modes: unknown mode '" + m + "' (cv, ism, vasm, mht)");
     }
   }
   if (!(o.timeout_s > 0.0)) {
@@ -371,7 +377,7 @@ int RunCompare(const CompareOptions& o) {
     if (!o.plots_dir.empty() && results.count(item.name)) {
       const std::string path = (fs::path(o.plots_dir) / (item.name + "_modes.png")).string();
       try {
-        WriteModePlot("vtrack-compare: " + item.name + " (ism, vasm, mht)", results[item.name], path);
+        WriteModePlot("vtrack-compare: " + item.name + " (" + JoinComma(o.modes) + ")", results[item.name], path);
         say(item.name + ": wrote " + path);
       } catch (const std::exception& e) {
         failures.push_back(item.name + ": " + e.what());

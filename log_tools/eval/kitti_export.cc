@@ -130,7 +130,7 @@ KittiExportStats ExportKittiTracking(const LogData& data, const std::string& mod
                     "%.6f %.6f\n",
                     static_cast<long long>(frame), static_cast<long long>(tr.id), alpha, u0, v0,
                     u1, v1, params.box_height_m, tr.width, tr.length, bottom_r.x(), bottom_r.y(),
-                    bottom_r.z(), rotation_y, 1.0);
+                    bottom_r.z(), rotation_y, static_cast<double>(tr.score));
       lines.push_back({frame, tr.id, buf});
     }
   }

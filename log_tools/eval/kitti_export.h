@@ -14,7 +14,9 @@
 //    relation yaw_velo = -rotation_y - pi/2 holds), alpha = rotation_y - atan2(x, z);
 //  - bbox: the 8 box corners projected with P2, clipped to the image; a track with a corner
 //    behind the camera or a box outside the image is not written;
-//  - score 1: tracks carry no detection confidence; only confirmed vehicle tracks are written.
+//  - score: the track's score (track_t.score: from a detector's boxes, the recency-weighted mean
+//    of their scores; from scans, n / (n + confirm_updates)), which ranks the tracks for the
+//    score-threshold sweep of sAMOTA; only confirmed vehicle tracks are written.
 #pragma once
 
 #include <Eigen/Geometry>

@@ -382,7 +382,8 @@ void WriteModePlot(const std::string& title, const std::map<std::string, EvalSum
     if (mode == "ism") return PaletteColor(0);
     if (mode == "vasm") return PaletteColor(1);
     if (mode == "mht") return PaletteColor(2);
-    return PaletteColor(static_cast<int>(std::hash<std::string>{}(mode) % 7) + 3);
+    if (mode == "cv") return PaletteColor(3);
+    return PaletteColor(static_cast<int>(std::hash<std::string>{}(mode) % 6) + 4);
   };
   for (const auto& [mode, s] : by_mode) {
     pos.series.push_back(PerScanMean(s, [](const PairSample& p) { return p.position_error_m; },

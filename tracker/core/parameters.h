@@ -320,6 +320,25 @@ struct VasmParams {
   bool Validate(std::string* error) const { return param::Validate(*this, error); }
 };
 
+struct CvParams {
+  static constexpr const char* kSection = "cv";
+  static constexpr const char* kAbout =
+      "Constant-velocity reference model (AB3DMOT's): constant centre velocity, heading a random walk";
+  // A CV hypothesis starts as an ISM one (ism.initial_velocity_std) without its yaw rate.
+  // Fitted by scripts/fit-cv-noise to the labelled cars and vans of the KITTI training
+  // sequences in the boxes layout (world-frame trajectories at a lag of 1 s).
+  double alpha = 0.54;
+  double q_theta = 0.0051;
+
+  template <class V>
+  void Visit(V& v) {
+    using namespace param;
+    v("alpha", &alpha, {"m^2/s^3", Above(0), "white acceleration density in x and in y, fitted to KITTI car trajectories (scripts/fit-cv-noise)"});
+    v("q_theta", &q_theta, {"rad^2/s", Above(0), "heading random-walk density (no yaw-rate state), fitted likewise"});
+  }
+  bool Validate(std::string* error) const { return param::Validate(*this, error); }
+};
+
 struct EkfParams {
   static constexpr const char* kSection = "ekf";
   static constexpr const char* kAbout =
@@ -359,13 +378,13 @@ struct ShapeParams {
   bool Validate(std::string* error) const { return param::Validate(*this, error); }
 };
 
-enum class TrackerMode { kMht, kIsm, kVasm };
+enum class TrackerMode { kMht, kIsm, kVasm, kCv };
 
 }  // namespace vtrack
 
 template <>
 struct vtrack::EnumNames<vtrack::TrackerMode> {
-  static constexpr std::array kNames{"mht", "ism", "vasm"};
+  static constexpr std::array kNames{"mht", "ism", "vasm", "cv"};
 };
 
 namespace vtrack {
@@ -435,7 +454,7 @@ struct TrackManagerParams {
   template <class V>
   void Visit(V& v) {
     using namespace param;
-    v("mode", &mode, {"-", {}, "mht: ISM and VASM hypotheses per mover; ism or vasm: one model only"});
+    v("mode", &mode, {"-", {}, "mht: ISM and VASM hypotheses per mover; ism or vasm: one model only; cv: the constant-velocity reference (no yaw rate)"});
     v("max_hypotheses", &max_hypotheses, {"-", Closed(1, 4), "hypotheses per mover, ISM included (paper: four)"});
     v("ism_inside_fraction", &ism_inside_fraction, {"-", Closed(0, 1), "required inside share of the ISM hypothesis (slot 0)"});
     v("vasm_variants", &vasm_variants, {"-", {}, "the VASM hypotheses: inside share and noise factor each (max_hypotheses - 1 used)"});
@@ -504,6 +523,7 @@ struct DetectionParams {
   double gate_m = 2.0;
   double gate_sigma = 3.0;
   double max_gate_m = 5.0;
+  double score_memory = 10.0;
 
   template <class V>
   void Visit(V& v) {
@@ -516,6 +536,7 @@ struct DetectionParams {
     v("gate_m", &gate_m, {"m", Above(0), "a box farther than this (+ gate_sigma predicted position stds) from a track is not its candidate"});
     v("gate_sigma", &gate_sigma, {"-", AtLeast(0), "predicted position stds added to gate_m"});
     v("max_gate_m", &max_gate_m, {"m", OpenClosed(0, 50), "upper bound of the whole gate (>= gate_m)"});
+    v("score_memory", &score_memory, {"-", Closed(1, 1000), "a track's score: mean of its boxes' scores, each update weighted 1/min(n, this) (recent boxes count more; 10: about 1 s at 10 Hz)"});
   }
   // gate_m <= max_gate_m.
   std::string CrossProblem() const;
@@ -532,9 +553,10 @@ struct TrackerParams {
   FitParams fit;
   IsmParams ism;
   VasmParams vasm;
+  CvParams cv;
   EkfParams ekf;
   ShapeParams shape;
-  TrackManagerParams manager;  // includes the mode (mht | ism | vasm)
+  TrackManagerParams manager;  // includes the mode (mht | ism | vasm | cv)
   DetectionParams detections;  // a detector's boxes: the input mode and their measurement model
 
   // Calls v(&section) for every component, in the order of config/tracker.yaml.
@@ -549,6 +571,7 @@ struct TrackerParams {
     v(&fit);
     v(&ism);
     v(&vasm);
+    v(&cv);
     v(&ekf);
     v(&shape);
     v(&manager);

@@ -61,6 +61,8 @@ struct Track {
   bool axis_from_full_face = false;       // heading set by a fully seen short face (AlignToFullFace)
   double full_face_extent = 0.0;          // [m] that face's extent (a car's front or rear width)
   int box_updates = 0;                    // [-] updates (and creation) by a detector's box
+  double box_score = 0.0;                 // [-] recency-weighted mean score of those boxes
+                                          //     (TrackManager::Report, "score")
   std::vector<TrackHypothesis> hyps;
   int selected = 0;                       // index into hyps of the reported hypothesis
 };
@@ -80,6 +82,9 @@ struct TrackReport {
   int num_hypotheses = 0;
   double age = 0;                         // [s]
   int num_updates = 0;
+  // [-] how likely the track is a real vehicle, higher is likelier (track_t.score): from a
+  // detector's boxes, on the detector's scale; from scans only, in [0, 1).
+  double score = 0;
   std::vector<PredictedPose> prediction;  // t after the report time
 };
 

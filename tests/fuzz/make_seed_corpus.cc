@@ -62,6 +62,8 @@ int main(int argc, char** argv) {
     Write(out / "track_list_t", n, r.TrackList(i));
     Write(out / "track_debug_t", n, r.Debug(i));
     Write(out / "tracker_status_t", n, r.Status());
+    Write(out / "detection_list_t", n, r.DetectionList(i * 3));
+    Write(out / "detection_t", n, r.Detection());
   }
   WriteBytes(out / "tracker", "mht_plane", TrackerProgram(0, 1, 0));
   WriteBytes(out / "tracker", "ism_cloud", TrackerProgram(1, 16, 0));

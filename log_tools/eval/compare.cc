@@ -129,8 +129,31 @@ double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
+// Means weighted by their samples: *err and *n from the parts' (error, samples) per horizon.
+void PoolMeans(const std::vector<std::pair<const std::vector<double>*, const std::vector<std::int64_t>*>>& parts,
+               std::vector<double>* err, std::vector<std::int64_t>* n) {
+  std::vector<double> sum;
+  for (const auto& [e, c] : parts) {
+    if (sum.size() < e->size()) {
+      sum.resize(e->size(), 0.0);
+      n->resize(e->size(), 0);
+    }
+    for (std::size_t h = 0; h < e->size() && h < c->size(); ++h) {
+      if ((*c)[h] > 0) {
+        sum[h] += (*e)[h] * static_cast<double>((*c)[h]);
+        (*n)[h] += (*c)[h];
+      }
+    }
+  }
+  err->assign(sum.size(), std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t h = 0; h < sum.size(); ++h) {
+    if ((*n)[h] > 0) (*err)[h] = sum[h] / static_cast<double>((*n)[h]);
+  }
+}
+
 // The CLEAR MOT counts of every sequence summed (MOTA recomputed from them, MOTP weighted by
-// the matches), and the prediction errors weighted by their samples; the rest is not summed.
+// the matches), and the prediction errors (all, turning, straight) weighted by their samples;
+// the rest is not summed.
 EvalSummary SumOf(const std::vector<const EvalSummary*>& parts) {
   EvalSummary s;
   double motp_sum = 0.0;
@@ -175,6 +198,14 @@ EvalSummary SumOf(const std::vector<const EvalSummary*>& parts) {
                                   ? pred_sum[h] / static_cast<double>(s.prediction_samples[h])
                                   : nan;
   }
+  std::vector<std::pair<const std::vector<double>*, const std::vector<std::int64_t>*>> turning, straight;
+  for (const EvalSummary* p : parts) {
+    turning.push_back({&p->prediction_error_turning_m, &p->prediction_samples_turning});
+    straight.push_back({&p->prediction_error_straight_m, &p->prediction_samples_straight});
+  }
+  PoolMeans(turning, &s.prediction_error_turning_m, &s.prediction_samples_turning);
+  PoolMeans(straight, &s.prediction_error_straight_m, &s.prediction_samples_straight);
+  if (!parts.empty()) s.params = parts.front()->params;  // the horizons, for the JSON
   s.hota.hota = s.hota.deta = s.hota.assa = s.hota.loca = nan;
   s.position_rmse_m = s.heading_rmse_deg = s.heading_flip_fraction = nan;
   s.speed_rmse_mps = s.yaw_rate_rmse_dps = s.rear_axle_rmse_m = nan;

@@ -81,7 +81,8 @@ Match Evaluate(const std::vector<ScanOutput>& outs, const SyntheticScene& scene,
 }
 
 TEST(TrackerTest, TracksParkedAndTurningCarsWithoutIdentitySwitch) {
-  for (TrackerMode mode : {TrackerMode::kMht, TrackerMode::kIsm, TrackerMode::kVasm}) {
+  for (TrackerMode mode :
+       {TrackerMode::kMht, TrackerMode::kIsm, TrackerMode::kVasm, TrackerMode::kCv}) {
     SCOPED_TRACE(ToString(mode));
     SyntheticScene scene(SceneConfig{}, TwoCars(), 42);
     TrackerParams params;
@@ -101,6 +102,12 @@ TEST(TrackerTest, TracksParkedAndTurningCarsWithoutIdentitySwitch) {
       EXPECT_LT(RadToDeg(hrmse), 6.0);
     }
     EXPECT_EQ(tracker.scans_dropped(), 0);
+    // Scans only: the score is n / (n + confirm_updates) for n updates, 0.5 at confirmation.
+    for (const TrackReport& r : outs.back().tracks) {
+      const double n = r.num_updates, c = params.manager.confirm_updates;
+      EXPECT_NEAR(r.score, n / (n + c), 1e-12);
+      if (r.status == TrackStatus::kConfirmed) EXPECT_GE(r.score, 0.5);
+    }
   }
 }
 

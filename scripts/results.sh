@@ -221,6 +221,7 @@ bench_table() {
     "| KITTI stages ms: preprocess / segmentation / association / updates + rest | \(if .kitti_stage_ms == null then "n/a" else "\(f(.kitti_stage_ms.preprocess; 2)) / \(f(.kitti_stage_ms.segmentation; 2)) / \(f(.kitti_stage_ms.association; 2)) / \(f(.kitti_stage_ms.updates_and_rest; 2))" end) | |",
     "| stress ms/scan median / p99 | \(f(.stress_ms_per_scan_median; 2)) / \(f(.stress_ms_per_scan_p99; 2)) | |",
     "| paper_fig4_turn ms/scan median | \(f(.fig4_ms_per_scan_median; 3)) | |",
+    "| boxes only (detector boxes, KITTI 0020, 837 frames): frames/s (CPU) \(.boxes_frames_per_s // {} | keys_unsorted | join(" / ")) | \(.boxes_frames_per_s // {} | to_entries | map(f(.value; 0)) | join(" / ")) | 2000 (mht): \(ok(if .boxes_frames_per_s.mht == null then null else .boxes_frames_per_s.mht >= 2000 end)) |",
     "| copy floor ms/scan; tracker / copy floor | \(f(.copy_floor_ms_per_scan; 3)); \(f(.copy_floor_ratio; 1)) | 10: \(ok(le(.copy_floor_ratio; 10))) |",
     "| points 10k..1M: ms/scan; growth exponent | \(.points_scaling | map("\(f(.ms; 1))") | join(" / ")); \(f(.points_growth_exponent; 2)) | ~1: \(ok(le(.points_growth_exponent; 1.2))) |",
     "| objects 10..1000: ms/scan; growth exponent | \(.objects_scaling | map("\(f(.ms; 1))") | join(" / ")); \(f(.objects_growth_exponent; 2)) | |",

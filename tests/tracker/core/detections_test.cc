@@ -72,7 +72,7 @@ TEST(BoxesInWorld, PlacesBoxesWithTheEgoPoseAndDropsWeakOnes) {
   d.height = 1.5;
   d.score = 5.0;
   list.boxes.push_back(d);
-  d.score = -1.0;  // below min_score
+  d.score = -3.0;  // below min_score
   list.boxes.push_back(d);
   // Ego at (100, 50) heading 90 deg: the box 10 m ahead is at (100, 60), heading 90 deg.
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();

@@ -68,6 +68,7 @@ int main(int argc, char** argv) {
   WriteBytes(out / "tracker", "mht_plane", TrackerProgram(0, 1, 0));
   WriteBytes(out / "tracker", "ism_cloud", TrackerProgram(1, 16, 0));
   WriteBytes(out / "tracker", "vasm_plane", TrackerProgram(2, 1, 0));
+  WriteBytes(out / "tracker", "cv_plane", TrackerProgram(3, 1, 0));
   WriteBytes(out / "tracker", "mht_plane_bad_returns", TrackerProgram(0, 1, 3));
   WriteBytes(out / "tracker", "mht_cloud_bad_returns", TrackerProgram(0, 16, 2));
   return 0;

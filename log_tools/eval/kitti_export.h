@@ -8,8 +8,9 @@
 //    converter stamps a frame's scan half a sweep before the labels' time (kitti_sequence.h);
 //  - world -> sensor by the ego pose at that time and the LADAR's mounting (from LADAR_SCAN),
 //    sensor -> rect by the calibration (X_rect = R0_rect Tr_velo_to_cam X_velo);
-//  - (x, y, z) is the bottom centre: the track's centre at z = -sensor_height_m in the sensor
-//    frame (the road); h = box_height_m (tracks carry no height), w and l from the track;
+//  - (x, y, z) is the bottom centre: the track's centre at its bottom z (track_t.z, world frame,
+//    from a detector's boxes), or where it has none at z = -sensor_height_m in the sensor frame
+//    (the road); h = the track's height (track_t.height) or box_height_m, w and l from the track;
 //  - rotation_y = atan2(-d_z, d_x) for the heading direction d in rect (so that the KITTI
 //    relation yaw_velo = -rotation_y - pi/2 holds), alpha = rotation_y - atan2(x, z);
 //  - bbox: the 8 box corners projected with P2, clipped to the image; a track with a corner

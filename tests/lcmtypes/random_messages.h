@@ -78,6 +78,7 @@ class RandomMessages {
     t.length = D(3, 6); t.width = D(1.5, 2.5);
     for (double& c : t.cov) c = D(-1, 1);
     t.num_hypotheses = I(1, 4); t.age = D(0, 100); t.num_updates = I(0, 1000); t.score = static_cast<float>(D(-5, 20));
+    t.z = D(-3, 1); t.height = D(1, 3);
     t.npred = npred;
     for (int i = 0; i < npred; ++i) {
       t.pred_t.push_back(0.1f * i); t.pred_x.push_back(D()); t.pred_y.push_back(D());

@@ -519,8 +519,8 @@ struct DetectionParams {
   // Every box of PointRCNN (its scores on the KITTI training sequences are >= -0.85): the weak
   // ones are mostly far cars (median score 0.5 at 60-70 m), which they keep tracked, and the
   // track score ranks them low. On the ten training sequences of the boxes layout, -1 instead of
-  // 2 raised sAMOTA (3-D IoU 0.25, mode mht) from 80.9 to 83.3 and the devkit's MOTA from 72.9 to
-  // 75.0; vtrack-eval's MOTA (centre gate 2 m, within 40 m) fell from 0.840 to 0.816 (more false
+  // 2 raises sAMOTA (3-D IoU 0.25, mode mht) from 84.1 to 86.7 and the devkit's MOTA from 77.7 to
+  // 80.4; vtrack-eval's MOTA (centre gate 2 m, within 40 m) falls from 0.840 to 0.816 (more false
   // positives near the threshold, which sAMOTA's sweep removes).
   double min_score = -1.0;
   double birth_score = 2.0;

@@ -286,6 +286,8 @@ void TrackManager::UpdateWithBox(std::size_t index, const BoxMeasurement& b,
     ++t.box_updates;
     const double w = 1.0 / std::min(static_cast<double>(t.box_updates), dp.score_memory);
     t.box_score += w * (b.score - t.box_score);
+    t.box_z += w * (b.z - t.box_z);
+    t.box_height += w * (b.height - t.box_height);
   }
   AfterUpdate(any, tm, /*pose_measured=*/true, &t);
 }
@@ -323,6 +325,8 @@ bool TrackManager::CreateFromBox(const BoxMeasurement& b, const DetectionParams&
   Track t;
   t.box_updates = 1;
   t.box_score = b.score;
+  t.box_z = b.z;
+  t.box_height = b.height;
   AddTrack(std::move(t), std::move(h), b.utime);
   return true;
 }
@@ -443,6 +447,10 @@ void TrackManager::Report(std::int64_t utime, std::vector<TrackReport>* out) con
     r.age = static_cast<double>(utime - t.created_utime) * 1e-6;
     r.num_updates = t.num_updates;
     r.score = TrackScore(t);
+    if (t.box_updates > 0) {
+      r.z = t.box_z;
+      r.height = t.box_height;
+    }
     r.object_class = Classify(params_, t);
     if (r.object_class != ObjectClass::kVehicle && sel.length_est && sel.width_est) {
       // Clutter: its own size, not the vehicle default.

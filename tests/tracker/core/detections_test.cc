@@ -170,9 +170,10 @@ TEST(TrackerBoxes, TrackScoreIsTheRecencyWeightedMeanOfItsBoxesScores) {
       Detection d;
       d.x = 10.0 + 0.8 * k;
       d.y = car == 0 ? 4.0 : -4.0;
+      d.z = car == 0 ? -1.6 : -1.9;  // bottom, body frame = world here
       d.length = 4.4;
       d.width = 1.8;
-      d.height = 1.5;
+      d.height = car == 0 ? 1.5 : 2.4;
       d.score = car == 0 ? strong(rng) : weak(rng);
       scores[car].push_back(d.score);
       list.boxes.push_back(d);
@@ -194,6 +195,9 @@ TEST(TrackerBoxes, TrackScoreIsTheRecencyWeightedMeanOfItsBoxesScores) {
         expected += w * s[i];
       }
       EXPECT_NEAR(r.score, expected, 1e-9) << "frame " << k;
+      // Bottom and height from the same boxes (constant per car here).
+      EXPECT_NEAR(r.z, r.y > 0.0 ? -1.6 : -1.9, 1e-9) << "frame " << k;
+      EXPECT_NEAR(r.height, r.y > 0.0 ? 1.5 : 2.4, 1e-9) << "frame " << k;
       ++checked;
     }
     const auto& tr = out[0].tracks;

@@ -35,7 +35,7 @@ struct KittiExportParams {
   int image_width = 1242;           // [px] > 0
   int image_height = 375;           // [px] > 0
   double sensor_height_m = 1.73;    // [m] LADAR above the road (KITTI's Velodyne); > 0
-  double box_height_m = 1.6;        // [m] height written for every track; > 0
+  double box_height_m = 1.6;        // [m] height written for tracks without one (scans); > 0
   double time_offset_s = -1.0;      // [s] state advance; < 0 = half the log's sweep duration
   bool score_coasting = false;      // [-] also write coasting tracks
   std::string Validate() const;     // "" if valid, else names the key and the value

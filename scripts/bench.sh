@@ -66,6 +66,7 @@ run_gbench() {
 if [ $report_only = 0 ]; then
 rm -f "$out"/*.json
 run_gbench tracker_bench
+run_gbench boxes_bench
 run_gbench stages_bench
 run_gbench models_bench
 run_gbench fitting_bench
@@ -108,7 +109,7 @@ else
 fi
 fi  # report_only
 if [ $report_only = 1 ]; then
-  for f in tracker_bench stages_bench models_bench fitting_bench pcl_bench e2e soak; do
+  for f in tracker_bench boxes_bench stages_bench models_bench fitting_bench pcl_bench e2e soak; do
     [ -s "$out/$f.json" ] || notes+=("no $f output in $out (not built, skipped or failed: see its .log)")
   done
 fi
@@ -121,7 +122,7 @@ side() { if [ -s "$out/$1.json" ]; then cat "$out/$1.json"; else echo '{}'; fi; 
 notes_json=$(printf '%s\n' "${notes[@]+"${notes[@]}"}" | jq -R . | jq -s 'map(select(length > 0))')
 
 jq -n \
-  --argjson tb "$(gb tracker_bench)" --argjson sb "$(gb stages_bench)" \
+  --argjson tb "$(gb tracker_bench)" --argjson sb "$(gb stages_bench)" --argjson xb "$(gb boxes_bench)" \
   --argjson mb "$(gb models_bench)" --argjson fb "$(gb fitting_bench)" \
   --argjson pb "$(gb pcl_bench)" --argjson e2e "$(side e2e)" --argjson soak "$(side soak)" \
   --argjson notes "$notes_json" --arg host "$(uname -n)" --arg cpu "$(nproc) cores" \
@@ -170,6 +171,9 @@ jq -n \
     rss_growth_pct: $soak.rss_growth_pct, rss_start_mb: $soak.rss_start_mb,
     rss_end_mb: $soak.rss_end_mb, rss_peak_mb: $soak.rss_peak_mb,
     heap_start_mb: $soak.heap_start_mb, heap_end_mb: $soak.heap_end_mb, heap_peak_mb: $soak.heap_peak_mb,
+    boxes_frames_per_s: ([$xb[] | select(.error_occurred != true)
+                          | {key: (.name | sub("^BM_BoxesSequence/"; "")), value: .frames_per_s}] | from_entries),
+    boxes_frames: (bm($xb; "BM_BoxesSequence").frames),
     stages_ms: ([$sb[] | {key: (.name | sub("^BM_"; "")), value: ms(.)}] | from_entries),
     models_us: ([$mb[] | {key: (.name | sub("^BM_"; "")), value: (ms(.) * 1000)}] | from_entries),
     fitting_us: ([$fb[] | {key: (.name | sub("^BM_"; "")), value: (ms(.) * 1000)}] | from_entries),
@@ -192,6 +196,9 @@ jq -r '
   ["stress stages ms: preprocess / segment / associate / updates+rest",
     (if .stress_stage_ms == null then "n/a" else "\(f(.stress_stage_ms.preprocess; 2)) / \(f(.stress_stage_ms.segmentation; 2)) / \(f(.stress_stage_ms.association; 2)) / \(f(.stress_stage_ms.updates_and_rest; 2))" end), "", ""],
   ["paper_fig4_turn ms/scan median", f(.fig4_ms_per_scan_median; 3), "", ""],
+  ["boxes only, KITTI 0020 frames/s (CPU) " + (.boxes_frames_per_s | keys_unsorted | join(" / ")),
+    (.boxes_frames_per_s | to_entries | map(f(.value; 0)) | join(" / ")), ">= 2000 (mht)",
+    ok(if .boxes_frames_per_s.mht == null then null else .boxes_frames_per_s.mht >= 2000 end)],
   ["copy floor ms/scan (KITTI point arrays)", f(.copy_floor_ms_per_scan; 3), "", ""],
   ["tracker / copy floor", f(.copy_floor_ratio; 1), "<= 10", ok(lt(.copy_floor_ratio; 10))],
   ["points 10k..1M: ms/scan", (.points_scaling | map("\(.n / 1000)k:\(f(.ms; 1))") | join(" ")), "", ""],

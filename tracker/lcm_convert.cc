@@ -107,6 +107,9 @@ track_t TrackToLcm(const TrackReport& r) {
   t.num_hypotheses = r.num_hypotheses;
   t.age = r.age;
   t.num_updates = r.num_updates;
+  t.score = static_cast<float>(r.score);
+  t.z = r.z;
+  t.height = r.height;
   t.npred = static_cast<int32_t>(r.prediction.size());
   for (const auto& p : r.prediction) {
     t.pred_t.push_back(static_cast<float>(p.t));

@@ -1,7 +1,7 @@
 // vtrack-tracker: tracks vehicles from LADAR_SCAN + EGO_POSE and publishes TRACKS,
 // TRACKER_STATUS and (with --debug) TRACK_DEBUG.
 //
-//   live on the bus:   vtrack-tracker [--config F] [--mode mht|ism|vasm] [--lcm-url URL]
+//   live on the bus:   vtrack-tracker [--config F] [--mode mht|ism|vasm|cv] [--lcm-url URL]
 //   over a log file:   vtrack-tracker --input run.lcm --output tracks.lcm [--mode ...] [--debug]
 //
 // Both ways go through the same TrackerNode and the same core calls; estimation uses message
@@ -189,7 +189,7 @@ int main(int argc, char** argv) {
       ("help,h", "show this help")
       ("config", po::value(&config)->default_value(VTRACK_DEFAULT_TRACKER_CONFIG),
        "tracker parameters (YAML, see config/tracker.yaml); empty: built-in defaults")
-      ("mode", po::value(&mode), "mht (default) | ism | vasm: overrides the config's manager.mode")
+      ("mode", po::value(&mode), "mht (default) | ism | vasm | cv: overrides the config's manager.mode")
       ("input-mode", po::value(&input_mode),
        "scans (default) | boxes | fused: what tracks are measured with (LADAR_SCAN, a detector's "
        "DETECTIONS, or both); overrides the config's detections.mode")
@@ -267,7 +267,7 @@ int main(int argc, char** argv) {
       }
     }
     if (vm.count("mode") && !FromName(mode, &params.manager.mode)) {
-      std::cerr << "vtrack-tracker: --mode '" << mode << "' must be mht, ism or vasm\n";
+      std::cerr << "vtrack-tracker: --mode '" << mode << "' must be mht, ism, vasm or cv\n";
       return 2;
     }
     if (vm.count("input-mode") && !FromName(input_mode, &params.detections.mode)) {

@@ -39,6 +39,13 @@ OrientedBox MakeBox(double x, double y, double theta, double length, double widt
 
 bool PositiveFinite(double v) { return std::isfinite(v) && v > 0.0; }
 
+// track_t.MODEL_* (also the hypotheses' model) to the scene's model.
+MotionModel ModelOf(std::int8_t model) {
+  return model == vtrack::track_t::MODEL_VASM ? MotionModel::kVasm
+         : model == vtrack::track_t::MODEL_CV ? MotionModel::kCv
+                                              : MotionModel::kIsm;
+}
+
 }  // namespace
 
 std::optional<Eigen::Isometry3d> PoseFromMsg(const vtrack::pose_t& msg, std::string* why) {
@@ -63,7 +70,7 @@ SceneTrack TrackFromMsg(const vtrack::track_t& msg) {
   t.status = msg.status == vtrack::track_t::STATUS_TENTATIVE ? TrackStatus::kTentative
              : msg.status == vtrack::track_t::STATUS_COASTING ? TrackStatus::kCoasting
                                                               : TrackStatus::kConfirmed;
-  t.model = msg.model == vtrack::track_t::MODEL_VASM ? MotionModel::kVasm : MotionModel::kIsm;
+  t.model = ModelOf(msg.model);
   t.moving = msg.moving;
   t.object_class = msg.object_class == vtrack::track_t::CLASS_VEHICLE ? TrackClass::kVehicle
                    : msg.object_class == vtrack::track_t::CLASS_OTHER ? TrackClass::kOther
@@ -117,7 +124,7 @@ SceneMeasurement MeasurementFromMsg(const vtrack::track_debug_entry_t& msg,
   for (const auto& h : msg.hypotheses) {
     SceneHypothesis sh;
     sh.index = h.index;
-    sh.model = h.model == vtrack::track_t::MODEL_VASM ? MotionModel::kVasm : MotionModel::kIsm;
+    sh.model = ModelOf(h.model);
     sh.selected = h.selected;
     sh.box = MakeBox(h.x, h.y, h.theta, length, width);
     sh.rear_axle_offset = h.rear_axle_offset;

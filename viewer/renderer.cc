@@ -274,7 +274,9 @@ std::string FormatUtc(std::int64_t utime) {
   return out;
 }
 
-const char* ModelName(MotionModel m) { return m == MotionModel::kVasm ? "VASM" : "ISM"; }
+const char* ModelName(MotionModel m) {
+  return m == MotionModel::kVasm ? "VASM" : m == MotionModel::kCv ? "CV" : "ISM";
+}
 
 bool IsClutter(const SceneTrack& t) { return t.object_class == TrackClass::kOther; }
 

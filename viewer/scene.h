@@ -23,7 +23,7 @@ inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Mirrors track_t.STATUS_*, MODEL_*, CLASS_* (same numbers).
 enum class TrackStatus : int { kTentative = 0, kConfirmed = 1, kCoasting = 2 };
-enum class MotionModel : int { kIsm = 0, kVasm = 1 };
+enum class MotionModel : int { kIsm = 0, kVasm = 1, kCv = 2 };
 enum class TrackClass : int { kUnknown = 0, kVehicle = 1, kOther = 2 };
 // Mirrors track_debug_entry_t.FIT_*.
 enum class FitKind : int { kNone = 0, kEdge = 1, kCorner = 2 };

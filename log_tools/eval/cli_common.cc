@@ -13,7 +13,7 @@ namespace vtrack::eval {
 
 void AddEvalOptions(po::options_description* desc, EvalCliOptions* o) {
   desc->add_options()
-    ("mode", po::value(&o->mode), "tracker mode whose TRACKS to score (ism, vasm, mht); "
+    ("mode", po::value(&o->mode), "tracker mode whose TRACKS to score (cv, ism, vasm, mht); "
                                   "default: the only one in the logs")
     ("gate", po::value(&o->gate_m)->default_value(o->gate_m),
      "[m] CLEAR MOT match gate on the centre distance")
@@ -44,9 +44,9 @@ void AddEvalOptions(po::options_description* desc, EvalCliOptions* o) {
     ("kitti-image-size", po::value(&o->kitti_image_size)->default_value(o->kitti_image_size),
      "[px] camera 2 image size WxH")
     ("kitti-sensor-height", po::value(&o->kitti_sensor_height_m)->default_value(o->kitti_sensor_height_m),
-     "[m] LADAR height above the road (bottom of exported boxes)")
+     "[m] LADAR height above the road (bottom of exported boxes of tracks without track_t.z)")
     ("kitti-box-height", po::value(&o->kitti_box_height_m)->default_value(o->kitti_box_height_m, "1.6"),
-     "[m] box height written for every exported track")
+     "[m] box height written for exported tracks without track_t.height (scans only)")
     ("kitti-time-offset", po::value(&o->kitti_time_offset_s)->default_value(o->kitti_time_offset_s),
      "[s] advance of exported states (scan time -> label time); < 0 = half the sweep duration");
 }

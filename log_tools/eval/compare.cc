@@ -101,6 +101,12 @@ void RunProcess(const std::vector<std::string>& argv, const std::string& log_pat
                            ") ends:\n" + Tail(log_path, 15));
 }
 
+std::string JoinComma(const std::vector<std::string>& v) {
+  std::string out;
+  for (const auto& s : v) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
 std::string DefaultBinDir() {
   std::error_code ec;
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
@@ -123,8 +129,31 @@ double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
+// Means weighted by their samples: *err and *n from the parts' (error, samples) per horizon.
+void PoolMeans(const std::vector<std::pair<const std::vector<double>*, const std::vector<std::int64_t>*>>& parts,
+               std::vector<double>* err, std::vector<std::int64_t>* n) {
+  std::vector<double> sum;
+  for (const auto& [e, c] : parts) {
+    if (sum.size() < e->size()) {
+      sum.resize(e->size(), 0.0);
+      n->resize(e->size(), 0);
+    }
+    for (std::size_t h = 0; h < e->size() && h < c->size(); ++h) {
+      if ((*c)[h] > 0) {
+        sum[h] += (*e)[h] * static_cast<double>((*c)[h]);
+        (*n)[h] += (*c)[h];
+      }
+    }
+  }
+  err->assign(sum.size(), std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t h = 0; h < sum.size(); ++h) {
+    if ((*n)[h] > 0) (*err)[h] = sum[h] / static_cast<double>((*n)[h]);
+  }
+}
+
 // The CLEAR MOT counts of every sequence summed (MOTA recomputed from them, MOTP weighted by
-// the matches), and the prediction errors weighted by their samples; the rest is not summed.
+// the matches), and the prediction errors (all, turning, straight) weighted by their samples;
+// the rest is not summed.
 EvalSummary SumOf(const std::vector<const EvalSummary*>& parts) {
   EvalSummary s;
   double motp_sum = 0.0;
@@ -169,6 +198,14 @@ EvalSummary SumOf(const std::vector<const EvalSummary*>& parts) {
                                   ? pred_sum[h] / static_cast<double>(s.prediction_samples[h])
                                   : nan;
   }
+  std::vector<std::pair<const std::vector<double>*, const std::vector<std::int64_t>*>> turning, straight;
+  for (const EvalSummary* p : parts) {
+    turning.push_back({&p->prediction_error_turning_m, &p->prediction_samples_turning});
+    straight.push_back({&p->prediction_error_straight_m, &p->prediction_samples_straight});
+  }
+  PoolMeans(turning, &s.prediction_error_turning_m, &s.prediction_samples_turning);
+  PoolMeans(straight, &s.prediction_error_straight_m, &s.prediction_samples_straight);
+  if (!parts.empty()) s.params = parts.front()->params;  // the horizons, for the JSON
   s.hota.hota = s.hota.deta = s.hota.assa = s.hota.loca = nan;
   s.position_rmse_m = s.heading_rmse_deg = s.heading_flip_fraction = nan;
   s.speed_rmse_mps = s.yaw_rate_rmse_dps = s.rear_axle_rmse_m = nan;
@@ -212,8 +249,8 @@ int RunCompare(const CompareOptions& o) {
   }
   if (o.modes.empty()) throw std::invalid_argument("--modes is empty");
   for (const auto& m : o.modes) {
-    if (m != "ism" && m != "vasm" && m != "mht") {
-      throw std::invalid_argument("--modes: unknown mode '" + m + "' (ism, vasm, mht)");
+    if (m != "cv" && m != "ism" && m != "vasm" && m != "mht") {
+      throw std::invalid_argument("--modes: unknown mode '" + m + "' (cv, ism, vasm, mht)");
     }
   }
   if (!(o.timeout_s > 0.0)) {
@@ -376,7 +413,7 @@ int RunCompare(const CompareOptions& o) {
     if (!o.plots_dir.empty() && results.count(item.name)) {
       const std::string path = (fs::path(o.plots_dir) / (item.name + "_modes.png")).string();
       try {
-        WriteModePlot("vtrack-compare: " + item.name + " (ism, vasm, mht)", results[item.name], path);
+        WriteModePlot("vtrack-compare: " + item.name + " (" + JoinComma(o.modes) + ")", results[item.name], path);
         say(item.name + ": wrote " + path);
       } catch (const std::exception& e) {
         failures.push_back(item.name + ": " + e.what());

@@ -134,6 +134,20 @@ std::optional<Eigen::Vector2d> TruthAt(const std::map<std::int64_t, vtrack::obje
   return Eigen::Vector2d((1 - s) * a->x + s * b->x, (1 - s) * a->y + s * b->y);
 }
 
+// The heading [rad] of truth object id at utime (interpolated the short way round between the
+// lists around it, as TruthAt); nullopt where TruthAt has no position.
+std::optional<double> TruthYawAt(const std::map<std::int64_t, vtrack::object_list_t>& truth,
+                                 std::int64_t id, std::int64_t utime, double max_gap_s) {
+  if (!TruthAt(truth, id, utime, max_gap_s)) return std::nullopt;
+  auto hi = truth.lower_bound(utime);
+  const vtrack::object_t* b = FindObject(hi->second, id);
+  if (hi->first == utime) return b->yaw;
+  const vtrack::object_t* a = FindObject(std::prev(hi)->second, id);
+  const double s = static_cast<double>(utime - std::prev(hi)->first) /
+                   static_cast<double>(hi->first - std::prev(hi)->first);
+  return WrapToPi(a->yaw + s * AngleDiff(b->yaw, a->yaw));
+}
+
 // True if an object or track of a frame can be scored: its position and heading are finite (a
 // NaN would poison every error sum it entered) and its id is new in the frame (ids holds those
 // seen). Otherwise counts "<kind>_not_finite" or "<kind>_duplicate_id" in *problems (printed in
@@ -183,6 +197,9 @@ std::string EvalParams::Validate() const {
     os << "moving_speed_mps must be >= 0, got " << moving_speed_mps;
   }
   for (const double h : horizons_s) positive("horizons_s", h);
+  if (os.tellp() == 0 && !(turning_yaw_rate >= 0.0 && std::isfinite(turning_yaw_rate))) {
+    os << "turning_yaw_rate must be >= 0, got " << turning_yaw_rate;
+  }
   if (os.tellp() == 0 && std::isinf(truth_time_offset_s)) {
     os << "truth_time_offset_s must be finite (or NaN for half the sweep), got " << truth_time_offset_s;
   }
@@ -494,7 +511,7 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params) {
   const std::int64_t t0 = frames.front().utime;
   const std::size_t nh = params.horizons_s.size();
   Stats pos, head, speed, yaw_rate, axle, nees;
-  std::vector<Stats> pred(nh);
+  std::vector<Stats> pred(nh), pred_turning(nh), pred_straight(nh);
   std::int64_t flips = 0, nees_inside = 0;
   struct PerTrack {
     TrackRow row;
@@ -576,6 +593,16 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params) {
         const auto truth_then = TruthAt(data.truth, o.id, when, params.max_truth_gap_s);
         if (!truth_then) continue;
         ps.prediction_error_m[h] = (*p - *truth_then).norm();
+        // Turning or straight over this horizon, from the truth's headings alone.
+        const auto yaw_then = TruthYawAt(data.truth, o.id, when, params.max_truth_gap_s);
+        const auto yaw_now = TruthYawAt(data.truth, o.id, f.utime - offset_us, params.max_truth_gap_s);
+        const double yaw_from = yaw_now ? *yaw_now : o.yaw;
+        if (yaw_then && std::abs(AngleDiff(*yaw_then, yaw_from)) >
+                            params.turning_yaw_rate * params.horizons_s[h]) {
+          pred_turning[h].Add(ps.prediction_error_m[h]);
+        } else if (yaw_then) {
+          pred_straight[h].Add(ps.prediction_error_m[h]);
+        }
       }
 
       pos.Add(ps.position_error_m);
@@ -614,6 +641,10 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params) {
   for (std::size_t h = 0; h < nh; ++h) {
     s.prediction_error_m.push_back(pred[h].Mean());
     s.prediction_samples.push_back(pred[h].n);
+    s.prediction_error_turning_m.push_back(pred_turning[h].Mean());
+    s.prediction_samples_turning.push_back(pred_turning[h].n);
+    s.prediction_error_straight_m.push_back(pred_straight[h].Mean());
+    s.prediction_samples_straight.push_back(pred_straight[h].n);
   }
   s.nees_mean = nees.Mean();
   s.nees_samples = nees.n;

@@ -79,6 +79,10 @@ struct EvalParams {
                                     //       vehicle's x axis; 360 = all around; (0, 360]
   std::vector<double> horizons_s = {1.0, 2.0, 3.0};  // [s] prediction horizons; each > 0
   double max_truth_gap_s = 0.5;     // [s] largest ground-truth gap interpolated across; > 0
+  // [rad/s] a prediction sample is "turning" if the truth's heading changes by more than this
+  // times the horizon between the sample's time and the horizon (its mean |yaw rate| over the
+  // horizon, from the truth's headings alone), else "straight"; >= 0
+  double turning_yaw_rate = 0.1;
   double moving_speed_mps = 0.5;    // [m/s] truth faster than this counts as moving (L error); >= 0
   double max_pose_gap_s = 0.5;      // [s] ego pose extrapolated at most this far for the region
   std::optional<CameraRegion> region_camera;  // score only inside this camera's view (also)
@@ -174,6 +178,9 @@ struct EvalSummary {
   std::int64_t rear_axle_samples = 0;
   std::vector<double> prediction_error_m;         // mean per horizon
   std::vector<std::int64_t> prediction_samples;   // per horizon
+  // The same split by the truth's motion over the horizon (EvalParams::turning_yaw_rate).
+  std::vector<double> prediction_error_turning_m, prediction_error_straight_m;
+  std::vector<std::int64_t> prediction_samples_turning, prediction_samples_straight;
   double nees_mean = 0.0;
   double nees_within_95 = 0.0;
   std::int64_t nees_samples = 0;

@@ -73,8 +73,12 @@ KittiExportStats ExportKittiTracking(const LogData& data, const std::string& mod
       const double speed = std::isfinite(tr.speed) ? tr.speed : 0.0;
       const double vh = std::isfinite(tr.velocity_heading) ? tr.velocity_heading : tr.theta;
       const double yaw_rate = std::isfinite(tr.yaw_rate) ? tr.yaw_rate : 0.0;
+      // A detector's boxes give the track its bottom and height; otherwise the road and the
+      // default height.
+      const bool has_z = std::isfinite(tr.z) && std::isfinite(tr.height) && tr.height > 0.0;
+      const double box_height = has_z ? tr.height : params.box_height_m;
       const Eigen::Vector3d centre_w(tr.x + speed * std::cos(vh) * dt,
-                                     tr.y + speed * std::sin(vh) * dt, 0.0);
+                                     tr.y + speed * std::sin(vh) * dt, has_z ? tr.z : 0.0);
       const double theta = tr.theta + yaw_rate * dt;
       if (!centre_w.allFinite() || !std::isfinite(theta) || !(tr.length > 0.0) ||
           !(tr.width > 0.0)) {
@@ -82,7 +86,7 @@ KittiExportStats ExportKittiTracking(const LogData& data, const std::string& mod
       }
       // Box in the sensor frame: bottom centre on the road, axes in the sensor's xy plane.
       Eigen::Vector3d c_s = sensor_from_world * centre_w;
-      c_s.z() = -params.sensor_height_m;
+      if (!has_z) c_s.z() = -params.sensor_height_m;
       Eigen::Vector3d h_s = sensor_from_world.linear() * Eigen::Vector3d(std::cos(theta), std::sin(theta), 0.0);
       h_s.z() = 0.0;
       h_s.normalize();
@@ -93,7 +97,7 @@ KittiExportStats ExportKittiTracking(const LogData& data, const std::string& mod
       int k = 0;
       for (const double a : {0.5, -0.5}) {
         for (const double b : {0.5, -0.5}) {
-          for (const double z : {0.0, params.box_height_m}) {
+          for (const double z : {0.0, box_height}) {
             corners[k++] = c_s + a * tr.length * h_s + b * tr.width * n_s + z * up;
           }
         }
@@ -129,8 +133,8 @@ KittiExportStats ExportKittiTracking(const LogData& data, const std::string& mod
                     "%lld %lld Car -1 -1 %.6f %.2f %.2f %.2f %.2f %.6f %.6f %.6f %.6f %.6f %.6f "
                     "%.6f %.6f\n",
                     static_cast<long long>(frame), static_cast<long long>(tr.id), alpha, u0, v0,
-                    u1, v1, params.box_height_m, tr.width, tr.length, bottom_r.x(), bottom_r.y(),
-                    bottom_r.z(), rotation_y, 1.0);
+                    u1, v1, box_height, tr.width, tr.length, bottom_r.x(), bottom_r.y(),
+                    bottom_r.z(), rotation_y, static_cast<double>(tr.score));
       lines.push_back({frame, tr.id, buf});
     }
   }

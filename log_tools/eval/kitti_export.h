@@ -8,13 +8,16 @@
 //    converter stamps a frame's scan half a sweep before the labels' time (kitti_sequence.h);
 //  - world -> sensor by the ego pose at that time and the LADAR's mounting (from LADAR_SCAN),
 //    sensor -> rect by the calibration (X_rect = R0_rect Tr_velo_to_cam X_velo);
-//  - (x, y, z) is the bottom centre: the track's centre at z = -sensor_height_m in the sensor
-//    frame (the road); h = box_height_m (tracks carry no height), w and l from the track;
+//  - (x, y, z) is the bottom centre: the track's centre at its bottom z (track_t.z, world frame,
+//    from a detector's boxes), or where it has none at z = -sensor_height_m in the sensor frame
+//    (the road); h = the track's height (track_t.height) or box_height_m, w and l from the track;
 //  - rotation_y = atan2(-d_z, d_x) for the heading direction d in rect (so that the KITTI
 //    relation yaw_velo = -rotation_y - pi/2 holds), alpha = rotation_y - atan2(x, z);
 //  - bbox: the 8 box corners projected with P2, clipped to the image; a track with a corner
 //    behind the camera or a box outside the image is not written;
-//  - score 1: tracks carry no detection confidence; only confirmed vehicle tracks are written.
+//  - score: the track's score (track_t.score: from a detector's boxes, the recency-weighted mean
+//    of their scores; from scans, n / (n + confirm_updates)), which ranks the tracks for the
+//    score-threshold sweep of sAMOTA; only confirmed vehicle tracks are written.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -32,7 +35,7 @@ struct KittiExportParams {
   int image_width = 1242;           // [px] > 0
   int image_height = 375;           // [px] > 0
   double sensor_height_m = 1.73;    // [m] LADAR above the road (KITTI's Velodyne); > 0
-  double box_height_m = 1.6;        // [m] height written for every track; > 0
+  double box_height_m = 1.6;        // [m] height written for tracks without one (scans); > 0
   double time_offset_s = -1.0;      // [s] state advance; < 0 = half the log's sweep duration
   bool score_coasting = false;      // [-] also write coasting tracks
   std::string Validate() const;     // "" if valid, else names the key and the value

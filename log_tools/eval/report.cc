@@ -110,6 +110,16 @@ std::string SummaryText(const EvalSummary& s) {
        << " m (" << s.prediction_samples[h] << ")";
   }
   os << "\n";
+  for (const bool turning : {true, false}) {
+    const auto& err = turning ? s.prediction_error_turning_m : s.prediction_error_straight_m;
+    const auto& n = turning ? s.prediction_samples_turning : s.prediction_samples_straight;
+    os << (turning ? "    truth turning " : "    truth straight");
+    for (std::size_t h = 0; h < s.params.horizons_s.size() && h < err.size(); ++h) {
+      os << "  " << HorizonKey(s.params.horizons_s[h]) << " s: " << Fixed(err[h], 3) << " m ("
+         << n[h] << ")";
+    }
+    os << "\n";
+  }
   os << "  NEES mean " << Fixed(s.nees_mean, 2) << " (3 if consistent), within 95 % bound "
      << Fixed(100.0 * s.nees_within_95, 1) << " % (" << s.nees_samples << " samples)\n";
   if (s.scans_without_tracks > 0 || s.tracks_without_truth > 0) {
@@ -233,6 +243,20 @@ std::string SummaryJson(const EvalSummary& s) {
     w.Key(HorizonKey(s.params.horizons_s[h])).Int(s.prediction_samples[h]);
   }
   w.EndObject();
+  // Split by the truth's motion over the horizon (EvalParams::turning_yaw_rate).
+  const auto split = [&](const char* key, const std::vector<double>& err,
+                         const std::vector<std::int64_t>& n) {
+    w.Key(key).BeginObject();
+    for (std::size_t h = 0; h < s.params.horizons_s.size() && h < err.size(); ++h) {
+      w.Key(HorizonKey(s.params.horizons_s[h])).BeginObject();
+      w.Key("error_m").Number(err[h]);
+      w.Key("samples").Int(n[h]);
+      w.EndObject();
+    }
+    w.EndObject();
+  };
+  split("prediction_turning", s.prediction_error_turning_m, s.prediction_samples_turning);
+  split("prediction_straight", s.prediction_error_straight_m, s.prediction_samples_straight);
   w.Key("nees_mean").Number(s.nees_mean);
   w.Key("nees_within_95").Number(s.nees_within_95);
   w.Key("nees_samples").Int(s.nees_samples);
@@ -382,7 +406,8 @@ void WriteModePlot(const std::string& title, const std::map<std::string, EvalSum
     if (mode == "ism") return PaletteColor(0);
     if (mode == "vasm") return PaletteColor(1);
     if (mode == "mht") return PaletteColor(2);
-    return PaletteColor(static_cast<int>(std::hash<std::string>{}(mode) % 7) + 3);
+    if (mode == "cv") return PaletteColor(3);
+    return PaletteColor(static_cast<int>(std::hash<std::string>{}(mode) % 6) + 4);
   };
   for (const auto& [mode, s] : by_mode) {
     pos.series.push_back(PerScanMean(s, [](const PairSample& p) { return p.position_error_m; },

@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "lcmtypes/util/decode.h"
+#include "vtrack/detection_list_t.hpp"
+#include "vtrack/detection_t.hpp"
 #include "vtrack/ladar_scan_t.hpp"
 #include "vtrack/object_list_t.hpp"
 #include "vtrack/pose_t.hpp"

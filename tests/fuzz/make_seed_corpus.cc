@@ -100,11 +100,14 @@ int main(int argc, char** argv) {
     Write(out / "track_list_t", n, r.TrackList(i));
     Write(out / "track_debug_t", n, r.Debug(i));
     Write(out / "tracker_status_t", n, r.Status());
+    Write(out / "detection_list_t", n, r.DetectionList(i * 3));
+    Write(out / "detection_t", n, r.Detection());
   }
   WriteLogSeeds(out / "log_reader", &r);
   WriteBytes(out / "tracker", "mht_plane", TrackerProgram(0, 1, 0));
   WriteBytes(out / "tracker", "ism_cloud", TrackerProgram(1, 16, 0));
   WriteBytes(out / "tracker", "vasm_plane", TrackerProgram(2, 1, 0));
+  WriteBytes(out / "tracker", "cv_plane", TrackerProgram(3, 1, 0));
   WriteBytes(out / "tracker", "mht_plane_bad_returns", TrackerProgram(0, 1, 3));
   WriteBytes(out / "tracker", "mht_cloud_bad_returns", TrackerProgram(0, 16, 2));
   return 0;

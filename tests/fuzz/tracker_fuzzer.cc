@@ -85,8 +85,12 @@ class Harness {
  public:
   explicit Harness(Reader* in) : in_(*in) {
     TrackerParams params;
-    const int mode = in_.U8() % 3;
-    params.manager.mode = mode == 0 ? TrackerMode::kMht : mode == 1 ? TrackerMode::kIsm : TrackerMode::kVasm;
+    // The mode from the first byte (% 4): mht, ism, vasm, cv.
+    const int mode = in_.U8() % 4;
+    params.manager.mode = mode == 0   ? TrackerMode::kMht
+                          : mode == 1 ? TrackerMode::kIsm
+                          : mode == 2 ? TrackerMode::kVasm
+                                      : TrackerMode::kCv;
     params.preprocess.max_points = 400;  // reachable by kScanHuge
     params.input.max_queued_scans = 4;
     rings_ = (in_.U8() & 1) ? 16 : 1;

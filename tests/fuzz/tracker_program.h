@@ -3,7 +3,7 @@
 // read as zero), so libFuzzer's mutations always reach the tracker. Shared with the seed writer
 // (make_seed_corpus.cc) so that the seeds are meaningful programs.
 //
-//   header:  mode (byte % 3: mht, ism, vasm), rings (byte: 1 or a 3-D cloud of 16 rings),
+//   header:  mode (byte % 4: mht, ism, vasm, cv), rings (byte: 1 or a 3-D cloud of 16 rings),
 //            number of objects (byte % 5), then per object 7 bytes:
 //            x, y (int8 x 0.5 m, world), yaw (byte x 2 pi / 256), length, width
 //            (1 + byte / 32 m), speed (int8 x 0.25 m/s), yaw rate (int8 x 0.01 rad/s)

@@ -4,12 +4,15 @@
 // TRACKER_STATUS.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -18,7 +21,9 @@
 #include "tests/integration/tracker_eval.h"
 #include "tests/support/subprocess.h"
 #include "tests/support/test_env.h"
+#include "vtrack/detection_list_t.hpp"
 #include "vtrack/ladar_scan_t.hpp"
+#include "vtrack/object_list_t.hpp"
 #include "vtrack/pose_t.hpp"
 #include "vtrack/track_list_t.hpp"
 #include "vtrack/tracker_status_t.hpp"
@@ -104,6 +109,123 @@ TEST_F(TrackerLogTest, Fig4TurnIsTrackedWithoutIdentitySwitchInEveryMode) {
       EXPECT_EQ(r.max_hyps_not_moving, 1);
     }
   }
+}
+
+// Fused input over a log: paper_fig4_turn's log (scans, poses, ground truth) with a DETECTIONS
+// list after each ground-truth list, holding only the turning car's box (its truth in the body
+// frame, score 7). The turning car, seen by the scans and the detector, keeps one track whose
+// score is the boxes'; the parked car beside the approach, seen by the scans only, still gets its
+// track (score from the scans, below 1).
+TEST_F(TrackerLogTest, FusedBoxesAndScansOfOneCarGiveOneTrackAndAScanOnlyCarStillGetsOne) {
+  const std::string sim = SimLog(*dir_, "paper_fig4_turn");
+  const std::string fused = *dir_ + "/fig4-fused-in.lcm", out = *dir_ + "/fig4-fused.lcm";
+  std::int64_t mover_id = -1, parked_id = -1;
+  int lists = 0;
+  {
+    lcm_util::LogReader in(sim);
+    lcm_util::LogWriter w(fused);
+    pose_t pose{};
+    bool have_pose = false;
+    while (const lcm::LogEvent* ev = in.Next()) {
+      w.Write(ev->timestamp, ev->channel, ev->data, static_cast<std::size_t>(ev->datalen));
+      if (ev->channel == "EGO_POSE") {
+        ASSERT_EQ(lcm_util::Decode(ev->data, static_cast<std::size_t>(ev->datalen), &pose),
+                  lcm_util::DecodeError::kNone);
+        have_pose = true;
+      }
+      if (ev->channel != "GROUND_TRUTH" || !have_pose) continue;
+      object_list_t truth;
+      ASSERT_EQ(lcm_util::Decode(ev->data, static_cast<std::size_t>(ev->datalen), &truth),
+                lcm_util::DecodeError::kNone);
+      Eigen::Isometry3d world_from_body = Eigen::Isometry3d::Identity();
+      world_from_body.linear() = Eigen::Quaterniond(pose.orientation[0], pose.orientation[1],
+                                                    pose.orientation[2], pose.orientation[3])
+                                     .normalized()
+                                     .toRotationMatrix();
+      world_from_body.translation() = Eigen::Vector3d(pose.pos[0], pose.pos[1], pose.pos[2]);
+      detection_list_t boxes{};
+      boxes.utime = truth.utime;
+      boxes.seq = lists++;
+      boxes.source = "truth";
+      for (const object_t& o : truth.objects) {
+        if (o.moving && mover_id < 0) mover_id = o.id;
+        if (!o.moving && o.object_class == object_t::CLASS_CAR && parked_id < 0) parked_id = o.id;
+        if (o.id != mover_id) continue;
+        const Eigen::Vector3d b = world_from_body.inverse() * Eigen::Vector3d(o.x, o.y, o.z);
+        const Eigen::Vector3d axis = world_from_body.linear().transpose() *
+                                     Eigen::Vector3d(std::cos(o.yaw), std::sin(o.yaw), 0.0);
+        detection_t d{};
+        d.object_class = object_t::CLASS_CAR;
+        d.score = 7.0f;
+        d.x = b.x();
+        d.y = b.y();
+        d.z = b.z();
+        d.yaw = std::atan2(axis.y(), axis.x());
+        d.length = o.length;
+        d.width = o.width;
+        d.height = o.height;
+        boxes.detections.push_back(d);
+      }
+      boxes.num_detections = static_cast<std::int32_t>(boxes.detections.size());
+      w.WriteMessage(ev->timestamp, "DETECTIONS", boxes);
+    }
+  }
+  ASSERT_GE(mover_id, 0);
+  ASSERT_GE(parked_id, 0);
+  ASSERT_GT(lists, 100);
+  ASSERT_EQ(Track(fused, out, {"--input-mode", "fused"}), 0) << ReadFile(out + ".txt");
+
+  // Each truth object's nearest non-tentative track within 1.5 m, from 2 s on.
+  std::map<std::int64_t, object_list_t> truth;
+  {
+    lcm_util::LogReader r(sim);
+    while (const lcm::LogEvent* ev = r.Next()) {
+      if (ev->channel != "GROUND_TRUTH") continue;
+      object_list_t m;
+      ASSERT_EQ(lcm_util::Decode(ev->data, static_cast<std::size_t>(ev->datalen), &m),
+                lcm_util::DecodeError::kNone);
+      truth[m.utime] = m;
+    }
+  }
+  const auto tracks = ReadTracks(out);
+  ASSERT_FALSE(tracks.empty());
+  const std::int64_t t0 = tracks.front().utime;
+  std::map<std::int64_t, std::set<std::int64_t>> ids;
+  std::map<std::int64_t, int> due, matched;
+  std::map<std::int64_t, float> last_score;
+  for (const track_list_t& l : tracks) {
+    const auto it = truth.find(l.utime);
+    if (it == truth.end() || l.utime - t0 < 2'000'000) continue;
+    for (const object_t& o : it->second.objects) {
+      if (o.id != mover_id && o.id != parked_id) continue;
+      if (!o.in_labelled_region || o.num_points < 3) continue;
+      ++due[o.id];
+      const track_t* best = nullptr;
+      double best_d = 1.5;
+      for (const track_t& t : l.tracks) {
+        if (t.status == track_t::STATUS_TENTATIVE) continue;
+        const double d = std::hypot(t.x - o.x, t.y - o.y);
+        if (d < best_d) {
+          best_d = d;
+          best = &t;
+        }
+      }
+      if (!best) continue;
+      ++matched[o.id];
+      ids[o.id].insert(best->id);
+      last_score[o.id] = best->score;
+    }
+  }
+  for (const std::int64_t id : {mover_id, parked_id}) {
+    SCOPED_TRACE(id == mover_id ? "turning car (scans and boxes)" : "parked car (scans only)");
+    ASSERT_GT(due[id], 20);
+    EXPECT_GE(matched[id], due[id] * 9 / 10);
+    EXPECT_EQ(ids[id].size(), 1u) << "identity switch";
+  }
+  EXPECT_NE(*ids[mover_id].begin(), *ids[parked_id].begin());
+  EXPECT_FLOAT_EQ(last_score[mover_id], 7.0f);
+  EXPECT_GT(last_score[parked_id], 0.5f);
+  EXPECT_LT(last_score[parked_id], 1.0f);
 }
 
 TEST_F(TrackerLogTest, ProcessingALogTwiceGivesIdenticalTracks) {

@@ -4,6 +4,7 @@
 #include <random>
 
 #include "tests/support/encode.h"
+#include "vtrack/detection_list_t.hpp"
 #include "vtrack/ladar_scan_t.hpp"
 #include "vtrack/object_list_t.hpp"
 #include "vtrack/pose_t.hpp"
@@ -76,7 +77,8 @@ class RandomMessages {
     t.velocity_heading = D(-3, 3); t.yaw_rate = D(-1, 1); t.rear_axle_offset = D(-2, 2);
     t.length = D(3, 6); t.width = D(1.5, 2.5);
     for (double& c : t.cov) c = D(-1, 1);
-    t.num_hypotheses = I(1, 4); t.age = D(0, 100); t.num_updates = I(0, 1000);
+    t.num_hypotheses = I(1, 4); t.age = D(0, 100); t.num_updates = I(0, 1000); t.score = static_cast<float>(D(-5, 20));
+    t.z = D(-3, 1); t.height = D(1, 3);
     t.npred = npred;
     for (int i = 0; i < npred; ++i) {
       t.pred_t.push_back(0.1f * i); t.pred_x.push_back(D()); t.pred_y.push_back(D());
@@ -128,6 +130,22 @@ class RandomMessages {
       for (int i = 0; i < e.num_hypotheses; ++i) e.hypotheses.push_back(Hypothesis(i));
       m.entries.push_back(e);
     }
+    return m;
+  }
+
+  detection_t Detection() {
+    detection_t d{};
+    d.object_class = static_cast<int8_t>(I(0, 3)); d.score = F(-2, 20);
+    d.x = D(-80, 80); d.y = D(-80, 80); d.z = D(-3, 1); d.yaw = D(-3, 3);
+    d.length = D(3, 6); d.width = D(1.5, 2.5); d.height = D(1.3, 2.2);
+    return d;
+  }
+
+  detection_list_t DetectionList(int n) {
+    detection_list_t m{};
+    m.utime = 1'600'000'000'000'000LL + I(0, 1'000'000);
+    m.seq = I(0, 1000); m.source = "pointrcnn"; m.num_detections = n;
+    for (int i = 0; i < n; ++i) m.detections.push_back(Detection());
     return m;
   }
 

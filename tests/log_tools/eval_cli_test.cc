@@ -10,11 +10,14 @@
 #include <numbers>
 #include <sstream>
 
+#include "lcmtypes/util/decode.h"
+#include "lcmtypes/util/log_reader.h"
 #include "sensor_driver/kitti/kitti_io.h"
 #include "tests/log_tools/synthetic_run.h"
 #include "tests/support/subprocess.h"
 #include "tests/support/test_env.h"
 #include "tests/support/tool_test.h"
+#include "vtrack/track_list_t.hpp"
 
 namespace vtrack::testing {
 namespace {
@@ -139,6 +142,69 @@ TEST_F(EvalCliTest, KittiExportFollowsTheCalibration) {
   EXPECT_NE(out.find("1 frames without pose"), std::string::npos) << out;
   EXPECT_GT(lines, b_lines);
   EXPECT_NE(out.find("states advanced 0.05 s"), std::string::npos) << out;  // half of 100 ms
+}
+
+// A track measured by a detector's boxes carries their bottom and height (track_t.z, height):
+// the export places the box there instead of on the road. Track 2 of the synthetic tracks given
+// z = -1.2 m (world = velo here: ego and sensor at the origin) and height 1.9 m: bottom centre
+// velo (10, -5, -1.2) -> cam (5, 1.2, 10), h 1.9.
+TEST_F(EvalCliTest, KittiExportTakesATracksBottomAndHeightFromItsBoxes) {
+  const std::string calib = dir_ + "/calib_z.txt";
+  {
+    std::ofstream c(calib);
+    const char* p = "500 0 600 0 0 500 180 0 0 0 1 0";
+    c << "P0: " << p << "\nP1: " << p << "\nP2: " << p << "\nP3: " << p << "\n"
+      << "R0_rect: 1 0 0 0 1 0 0 0 1\n"
+      << "Tr_velo_to_cam: 0 -1 0 0 0 0 -1 0 1 0 0 0\n"
+      << "Tr_imu_to_velo: 1 0 0 0 0 1 0 0 0 0 1 0\n";
+  }
+  const std::string tracks_z = dir_ + "/tracks_z.lcm";
+  {
+    lcm_util::LogReader in(tracks_);
+    lcm_util::LogWriter w(tracks_z);
+    while (const lcm::LogEvent* ev = in.Next()) {
+      if (ev->channel != "TRACKS") {
+        w.Write(ev->timestamp, ev->channel, ev->data, static_cast<std::size_t>(ev->datalen));
+        continue;
+      }
+      vtrack::track_list_t m;
+      ASSERT_EQ(lcm_util::Decode(ev->data, static_cast<std::size_t>(ev->datalen), &m),
+                lcm_util::DecodeError::kNone);
+      for (auto& t : m.tracks) {
+        if (t.id != 2) continue;
+        t.z = -1.2;
+        t.height = 1.9;
+      }
+      w.WriteMessage(ev->timestamp, "TRACKS", m);
+    }
+  }
+  const std::string out_file = dir_ + "/kitti_z.txt";
+  std::string out;
+  ASSERT_EQ(RunTool({run_, tracks_z, "--kitti-calib", calib, "--kitti-out", out_file,
+                     "--kitti-image-size", "1200x360"}, &out), 0) << out;
+  std::ifstream in(out_file);
+  int b_lines = 0, other_lines = 0;
+  for (std::string l; std::getline(in, l);) {
+    std::istringstream ss(l);
+    long long frame = 0, id = 0;
+    std::string type;
+    double trunc, occ, alpha, x1, y1, x2, y2, h, w, len, x, y, z, ry, score;
+    ASSERT_TRUE(ss >> frame >> id >> type >> trunc >> occ >> alpha >> x1 >> y1 >> x2 >> y2 >> h >>
+                w >> len >> x >> y >> z >> ry >> score) << l;
+    if (id == 2) {
+      ++b_lines;
+      EXPECT_NEAR(x, 5.0, 1e-5);
+      EXPECT_NEAR(y, 1.2, 1e-5);
+      EXPECT_NEAR(z, 10.0, 1e-5);
+      EXPECT_NEAR(h, 1.9, 1e-9);
+    } else {
+      ++other_lines;
+      EXPECT_NEAR(y, 1.73, 1e-5) << l;  // no box measured it: on the road
+      EXPECT_NEAR(h, 1.6, 1e-9) << l;
+    }
+  }
+  EXPECT_EQ(b_lines, kScans);
+  EXPECT_GT(other_lines, 0);
 }
 
 }  // namespace

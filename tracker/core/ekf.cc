@@ -149,8 +149,8 @@ double ChiSquareQuantile(double p, int dof) {
   return 0.5 * (lo + hi);
 }
 
-Ekf::Ekf(const IsmParams& ism, const VasmParams& vasm, const EkfParams& ekf)
-    : ism_(ism), vasm_(vasm), params_(ekf) {
+Ekf::Ekf(const IsmParams& ism, const VasmParams& vasm, const EkfParams& ekf, const CvParams& cv)
+    : ism_(ism), vasm_(vasm), cv_(cv), params_(ekf) {
   std::string error;
   if (!params_.Validate(&error)) throw std::invalid_argument(error);
   gate_nis_ = ChiSquareQuantile(params_.gate_probability, 3);
@@ -162,6 +162,8 @@ const MotionModel& Ekf::model(ModelKind kind) const {
       return ism_;
     case ModelKind::kVasm:
       return vasm_;
+    case ModelKind::kCv:
+      return cv_;
   }
   throw std::invalid_argument("Ekf::model: unknown model kind " +
                               std::to_string(static_cast<int>(kind)));

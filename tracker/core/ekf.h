@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "tracker/core/cv.h"
 #include "tracker/core/ism.h"
 #include "tracker/core/motion_model.h"
 #include "tracker/core/vasm.h"
@@ -90,15 +91,16 @@ struct PredictedPose {
   double pos_std = 0.0;  // [m] sqrt of the largest eigenvalue of the (x, y) covariance
 };
 
-// Holds both models and the gate; every operation the tracker performs on a hypothesis.
+// Holds the models (ISM, VASM, CV) and the gate; every operation the tracker performs on a hypothesis.
 class Ekf {
  public:
   // Throws std::invalid_argument with the Validate() message of the first invalid params.
   explicit Ekf(const IsmParams& ism = IsmParams(), const VasmParams& vasm = VasmParams(),
-               const EkfParams& ekf = EkfParams());
+               const EkfParams& ekf = EkfParams(), const CvParams& cv = CvParams());
 
   const IsmModel& ism() const { return ism_; }
   const VasmModel& vasm() const { return vasm_; }
+  const CvModel& cv() const { return cv_; }
   const MotionModel& model(ModelKind kind) const;
   const EkfParams& params() const { return params_; }
   double gate_nis() const { return gate_nis_; }  // [-] chi-square 3-dof quantile of the gate
@@ -133,6 +135,7 @@ class Ekf {
  private:
   IsmModel ism_;
   VasmModel vasm_;
+  CvModel cv_;
   EkfParams params_;
   double gate_nis_;
 };

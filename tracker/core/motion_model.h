@@ -5,6 +5,7 @@
 // its meaning:
 //   ISM  (ism.h,  Eq. 1):  (x, x_dot, y, y_dot, theta, theta_dot)
 //   VASM (vasm.h, Sec 2.2): (x, y, L, v, theta, theta_dot)
+//   CV   (cv.h, the reference of 3-D MOT papers): the ISM's layout with theta_dot held at 0
 // (x, y) is always the centre of the vehicle rectangle in the world frame [m] and theta the
 // direction of its length axis [rad], wrapped to (-pi, pi]. The measurement of Eq. 14 picks
 // (x, y, theta): ISM indices 0, 2, 4 and VASM indices 0, 1, 4 (docs/design.md note 1).
@@ -27,13 +28,17 @@ namespace vtrack {
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
-enum class ModelKind : int { kIsm = 0, kVasm = 1 };  // same values as track_t.MODEL_*
+enum class ModelKind : int { kIsm = 0, kVasm = 1, kCv = 2 };  // same values as track_t.MODEL_*
+
+// True for the models whose state has the ISM's layout (x, x_dot, y, y_dot, theta, theta_dot):
+// the ISM and the constant-velocity model (cv.h, theta_dot held at 0).
+inline bool HasIsmLayout(ModelKind kind) { return kind != ModelKind::kVasm; }
 
 }  // namespace vtrack
 
 template <>
 struct vtrack::EnumNames<vtrack::ModelKind> {
-  static constexpr std::array kNames{"ISM", "VASM"};
+  static constexpr std::array kNames{"ISM", "VASM", "CV"};
 };
 
 namespace vtrack {

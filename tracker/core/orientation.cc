@@ -28,7 +28,7 @@ void TurnAxis(const Ekf& ekf, ModelKind kind, int quarter_turns, TrackHypothesis
 
 void AlignIsmToMotion(const Ekf& ekf, double ambiguity_deg, Track* t) {
   for (auto& h : t->hyps) {
-    if (h.filter.kind != ModelKind::kIsm) continue;
+    if (!HasIsmLayout(h.filter.kind)) continue;
     const CentreEstimate c = ekf.Centre(h.filter);
     const double theta = h.filter.x(4);
     const double off = AngleDiff(c.velocity_heading, theta);
@@ -38,7 +38,7 @@ void AlignIsmToMotion(const Ekf& ekf, double ambiguity_deg, Track* t) {
     if (std::abs(k) % 2 == 1 && residual > DegToRad(45.0 - 0.5 * ambiguity_deg)) {
       continue;  // too near the diagonal to tell
     }
-    TurnAxis(ekf, ModelKind::kIsm, k, &h);
+    TurnAxis(ekf, h.filter.kind, k, &h);
   }
 }
 
@@ -60,26 +60,26 @@ void AlignToShape(const Ekf& ekf, const TrackManagerParams& params, Track* t) {
   // "width" is shorter than any vehicle's length: a car's end face seen whole (1.8 m) beside the
   // first metre of its side is not a side.
   for (auto& h : t->hyps) {
-    if (h.filter.kind != ModelKind::kIsm || !h.length_est || !h.width_est) continue;
+    if (!HasIsmLayout(h.filter.kind) || !h.length_est || !h.width_est) continue;
     if (*h.width_est <= std::max(params.axis_swap_ratio * *h.length_est,
                                  params.vehicle_min_length)) {
       continue;
     }
-    TurnAxis(ekf, ModelKind::kIsm, 1, &h);
+    TurnAxis(ekf, h.filter.kind, 1, &h);
   }
 }
 
 namespace {
 
-// Turns the ISM hypotheses of t by 90 deg and measures each afresh with the new heading: the
+// Turns the ISM (and CV) hypotheses of t by 90 deg and measures each afresh with the new heading: the
 // centre moves with the axis (half the default length behind the face instead of half the
 // width), and keeping the old position would turn the jump into a false velocity. The centre
 // velocity carries over.
 void TurnAcrossFace(const Ekf& ekf, const PointSet& points, const Eigen::Vector2d& sensor_xy,
                     std::uint64_t seed, TrackMeasurer* measurer, Track* t) {
   for (auto& h : t->hyps) {
-    if (h.filter.kind != ModelKind::kIsm) continue;
-    TurnAxis(ekf, ModelKind::kIsm, 1, &h);
+    if (!HasIsmLayout(h.filter.kind)) continue;
+    TurnAxis(ekf, h.filter.kind, 1, &h);
     const Hypothesis turned = h.filter;
     CentreMeasurement m;
     if (measurer->Measure(false, points, sensor_xy, seed, turned.x(4), std::nullopt, &h, &m) &&
@@ -89,7 +89,7 @@ void TurnAcrossFace(const Ekf& ekf, const PointSet& points, const Eigen::Vector2
         ism.x(i) = turned.x(i);
         for (int j : {1, 3, 5}) ism.P(i, j) = turned.P(i, j);
       }
-      h.filter = ism;
+      h.filter = ekf.Convert(ism, turned.kind, 0.0);  // a CV hypothesis stays one
     }
   }
 }
@@ -100,7 +100,7 @@ void AlignToFullFace(const Ekf& ekf, const TrackManagerParams& params, const Poi
                      const Eigen::Vector2d& sensor_xy, std::uint64_t seed,
                      const RangeProfile& profile, TrackMeasurer* measurer, Track* t) {
   const TrackHypothesis& sel = t->hyps[static_cast<std::size_t>(t->selected)];
-  if (!sel.updated_this_scan || !sel.has_fit || sel.filter.kind != ModelKind::kIsm) return;
+  if (!sel.updated_this_scan || !sel.has_fit || !HasIsmLayout(sel.filter.kind)) return;
   for (int e = 0; e < sel.fit.num_edges; ++e) {
     const FittedEdge& ed = sel.fit.edges[static_cast<std::size_t>(e)];
     const Eigen::Vector2d a = ed.start + points.origin, b = ed.end + points.origin;

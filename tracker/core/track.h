@@ -62,6 +62,9 @@ struct Track {
   double full_face_extent = 0.0;          // [m] that face's extent (a car's front or rear width)
   int box_updates = 0;                    // [-] updates (and creation) by a detector's box
   std::int64_t last_box_utime = -1;       // [us] time of the latest box update; -1 = never
+  double box_score = 0.0;                 // [-] recency-weighted mean score of those boxes
+                                          //     (TrackManager::Report, "score")
+  double box_z = 0.0, box_height = 0.0;   // [m] the same mean of their bottom (world) and height
   std::vector<TrackHypothesis> hyps;
   int selected = 0;                       // index into hyps of the reported hypothesis
 };
@@ -81,6 +84,13 @@ struct TrackReport {
   int num_hypotheses = 0;
   double age = 0;                         // [s]
   int num_updates = 0;
+  // [-] how likely the track is a real vehicle, higher is likelier (track_t.score): from a
+  // detector's boxes, on the detector's scale; from scans only, in [0, 1).
+  double score = 0;
+  // [m] bottom of the object (world frame) and its height, from a detector's boxes (the same
+  // recency-weighted mean as score); NaN for a track no box measured (the LADAR tracks in 2-D).
+  double z = std::numeric_limits<double>::quiet_NaN();
+  double height = std::numeric_limits<double>::quiet_NaN();
   std::vector<PredictedPose> prediction;  // t after the report time
 };
 

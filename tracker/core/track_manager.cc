@@ -20,6 +20,13 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // still occupy about a LADAR footprint.
 constexpr double kMinObservedExtent = 0.1;  // [m]
 
+// The model of an object's first hypothesis: VASM in mode vasm, CV in mode cv, else ISM.
+ModelKind FirstModel(TrackerMode mode) {
+  return mode == TrackerMode::kVasm ? ModelKind::kVasm
+         : mode == TrackerMode::kCv ? ModelKind::kCv
+                                    : ModelKind::kIsm;
+}
+
 }  // namespace
 
 std::string TrackManagerParams::CrossProblem() const {
@@ -139,8 +146,7 @@ void TrackManager::GrowIntoRectangle(const PointSet& points, const Eigen::Vector
     ism.x(i) = old_ism.x(i);
     for (int j : {1, 3}) ism.P(i, j) = old_ism.P(i, j);
   }
-  fresh.filter = params_.mode == TrackerMode::kVasm ? ekf_.Convert(ism, ModelKind::kVasm, 0.0)
-                                                    : ism;
+  fresh.filter = ekf_.Convert(ism, FirstModel(params_.mode), 0.0);
   fresh.last_logdet = h0.last_logdet;
   fresh.score_terms = h0.score_terms;
   fresh.has_fit = false;
@@ -275,7 +281,13 @@ void TrackManager::UpdateWithBox(std::size_t index, const BoxMeasurement& b,
     }
   }
   if (any) {
+    // Recency-weighted mean of the boxes' scores: the plain mean over the first score_memory
+    // boxes, then an exponential average with weight 1 / score_memory.
     ++t.box_updates;
+    const double w = 1.0 / std::min(static_cast<double>(t.box_updates), dp.score_memory);
+    t.box_score += w * (b.score - t.box_score);
+    t.box_z += w * (b.z - t.box_z);
+    t.box_height += w * (b.height - t.box_height);
     t.last_box_utime = b.utime;
     t.small_object = false;  // the box is a full view of a vehicle's rectangle
   }
@@ -315,6 +327,9 @@ bool TrackManager::CreateFromBox(const BoxMeasurement& b, const DetectionParams&
   Track t;
   t.box_updates = 1;
   t.last_box_utime = b.utime;
+  t.box_score = b.score;
+  t.box_z = b.z;
+  t.box_height = b.height;
   AddTrack(std::move(t), std::move(h), b.utime);
   return true;
 }
@@ -329,8 +344,7 @@ TrackHypothesis TrackManager::FirstHypothesis() const {
 }
 
 void TrackManager::StartFilter(const CentreMeasurement& m, TrackHypothesis* h) const {
-  h->filter = ekf_.InitIsm(m);
-  if (params_.mode == TrackerMode::kVasm) h->filter = ekf_.Convert(h->filter, ModelKind::kVasm, 0.0);
+  h->filter = ekf_.Convert(ekf_.InitIsm(m), FirstModel(params_.mode), 0.0);
   h->last_logdet = std::log(std::max(1e-300, (2.0 * kPi * m.R).determinant()));
   // The first scan's score term: the NIS of a measurement at its expected value (3, the
   // measurement's dimension) with the measurement's own covariance.
@@ -435,6 +449,11 @@ void TrackManager::Report(std::int64_t utime, std::vector<TrackReport>* out) con
     r.num_hypotheses = static_cast<int>(t.hyps.size());
     r.age = static_cast<double>(utime - t.created_utime) * 1e-6;
     r.num_updates = t.num_updates;
+    r.score = TrackScore(t);
+    if (t.box_updates > 0) {
+      r.z = t.box_z;
+      r.height = t.box_height;
+    }
     r.object_class = Classify(params_, t, vehicle_needs_box_, utime);
     if (r.object_class != ObjectClass::kVehicle && sel.length_est && sel.width_est) {
       // Clutter: its own size, not the vehicle default.
@@ -445,6 +464,14 @@ void TrackManager::Report(std::int64_t utime, std::vector<TrackReport>* out) con
                                           params_.prediction_step_s, sel.noise_scale);
     out->push_back(std::move(r));
   }
+}
+
+double TrackManager::TrackScore(const Track& t) const {
+  if (t.box_updates > 0) return t.box_score;
+  // Scans only: n / (n + confirm_updates) for n updates, 0.5 at confirmation, rising towards 1
+  // as the returns keep fitting the track.
+  const double n = static_cast<double>(t.num_updates);
+  return n / (n + static_cast<double>(params_.confirm_updates));
 }
 
 void TrackManager::FillDebug(const Track& t, const PointSet& points,

@@ -35,6 +35,14 @@
 // hypothesis for inflating its covariance. The reported hypothesis is the best score; it changes
 // only when another is better by switch_margin (hysteresis against flicker).
 //
+// Track score (TrackReport::score, track_t.score): how likely the track is a real vehicle, for
+// ranking tracks (the score-threshold sweep of sAMOTA). A track that a detector's box updated or
+// started: the recency-weighted mean of those boxes' scores, on the detector's scale (the plain
+// mean over the first DetectionParams::score_memory boxes, then each new box weighted
+// 1 / score_memory; AB3DMOT takes the plain mean). A track measured by scans only: n / (n +
+// confirm_updates) for its n updates, in [0, 1): 0.5 at confirmation. In fused mode a track no
+// box ever measured thus ranks below a detected one of positive score.
+//
 // Failure and re-seeding. A hypothesis that gets no accepted update in fail_misses consecutive
 // scans in which the object had points, while the reported one was updated, has failed ("fails to
 // fit for a few frames"): it is re-seeded from the reported hypothesis (Ekf::Convert into its own
@@ -155,6 +163,8 @@ class TrackManager {
   void FillDebug(const Track& t, const PointSet& points, const Eigen::Vector2d& sensor_xy,
                  TrackDebug* debug) const;
   HypothesisReport ReportHypothesis(const Track& t, std::size_t k) const;
+  // TrackReport::score (track_manager.h, "Track score").
+  double TrackScore(const Track& t) const;
 
   TrackManagerParams params_;
   const Ekf& ekf_;

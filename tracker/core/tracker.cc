@@ -52,7 +52,7 @@ Tracker::Tracker(const TrackerParams& params, bool debug)
       created_(params.association) {
   std::string error;
   if (!params_.Validate(&error)) throw std::invalid_argument(error);
-  ekf_ = std::make_unique<Ekf>(params_.ism, params_.vasm, params_.ekf);
+  ekf_ = std::make_unique<Ekf>(params_.ism, params_.vasm, params_.ekf, params_.cv);
   manager_ = std::make_unique<TrackManager>(params_.manager, *ekf_, params_.fit, params_.shape);
   manager_->SetVehicleNeedsBox(params_.detections.mode == InputMode::kFused &&
                                params_.detections.fused_vehicle_needs_box);

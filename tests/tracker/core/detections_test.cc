@@ -74,7 +74,7 @@ TEST(BoxesInWorld, PlacesBoxesWithTheEgoPoseAndDropsWeakOnes) {
   d.height = 1.5;
   d.score = 5.0;
   list.boxes.push_back(d);
-  d.score = -1.0;  // below min_score
+  d.score = -3.0;  // below min_score
   list.boxes.push_back(d);
   // Ego at (100, 50) heading 90 deg: the box 10 m ahead is at (100, 60), heading 90 deg.
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
@@ -144,6 +144,68 @@ TEST(TrackerBoxes, FollowsACarWhoseBoxesAreNoisyAndOftenTurnedAround) {
   EXPECT_EQ(ids.size(), 1u);
   EXPECT_EQ(frames_checked, 21);
   EXPECT_EQ(tracker.rejects().count("bad_detections"), 0u);
+}
+
+// Two cars side by side whose boxes come with seeded random scores, one car's higher on the
+// whole: each track's score is the recency-weighted mean of its own boxes' scores (computed here
+// with explicit weights: the plain mean of the first score_memory boxes, then each later box
+// weighted 1 / score_memory), and ranks the cars.
+TEST(TrackerBoxes, TrackScoreIsTheRecencyWeightedMeanOfItsBoxesScores) {
+  TrackerParams params;
+  params.detections.mode = InputMode::kBoxes;
+  params.detections.min_score = -10.0;
+  params.detections.birth_score = -10.0;
+  params.detections.score_memory = 4.0;
+  Tracker tracker(params);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> strong(4.0, 12.0), weak(-1.0, 5.0);
+  std::vector<double> scores[2];
+  std::vector<ScanOutput> out;
+  int checked = 0;
+  for (int k = 0; k < 15; ++k) {
+    const std::int64_t t = kT0 + k * 100'000;
+    tracker.AddPose({t, Eigen::Isometry3d::Identity()}, &out);
+    DetectionList list;
+    list.utime = t;
+    list.seq = k;
+    for (int car = 0; car < 2; ++car) {
+      Detection d;
+      d.x = 10.0 + 0.8 * k;
+      d.y = car == 0 ? 4.0 : -4.0;
+      d.z = car == 0 ? -1.6 : -1.9;  // bottom, body frame = world here
+      d.length = 4.4;
+      d.width = 1.8;
+      d.height = car == 0 ? 1.5 : 2.4;
+      d.score = car == 0 ? strong(rng) : weak(rng);
+      scores[car].push_back(d.score);
+      list.boxes.push_back(d);
+    }
+    out.clear();
+    tracker.AddDetections(std::move(list), &out);
+    ASSERT_EQ(out.size(), 1u);
+    ASSERT_EQ(out[0].tracks.size(), 2u);
+    for (const TrackReport& r : out[0].tracks) {
+      const std::vector<double>& s = scores[r.y > 0.0 ? 0 : 1];
+      const std::size_t n = s.size(), N = 4;
+      double expected = 0.0;
+      for (std::size_t i = 0; i < n; ++i) {
+        // Box i's weight: 1/min(n, N) within the first N, scaled by (1 - 1/N) per later box;
+        // a later box j > N: (1/N) (1 - 1/N)^(n - 1 - j).
+        const double w = i < N ? std::pow(1.0 - 1.0 / N, static_cast<double>(n > N ? n - N : 0)) /
+                                     static_cast<double>(std::min(n, N))
+                               : std::pow(1.0 - 1.0 / N, static_cast<double>(n - 1 - i)) / N;
+        expected += w * s[i];
+      }
+      EXPECT_NEAR(r.score, expected, 1e-9) << "frame " << k;
+      // Bottom and height from the same boxes (constant per car here).
+      EXPECT_NEAR(r.z, r.y > 0.0 ? -1.6 : -1.9, 1e-9) << "frame " << k;
+      EXPECT_NEAR(r.height, r.y > 0.0 ? 1.5 : 2.4, 1e-9) << "frame " << k;
+      ++checked;
+    }
+    const auto& tr = out[0].tracks;
+    if (k >= 5) EXPECT_EQ(tr[0].y > 0.0, tr[0].score > tr[1].score) << "frame " << k;
+  }
+  EXPECT_EQ(checked, 30);
 }
 
 TEST(TrackerBoxes, RefusesAListWithANonFiniteBoxAndIgnoresBoxesWithScansOnly) {

@@ -82,7 +82,8 @@ Match Evaluate(const std::vector<ScanOutput>& outs, const SyntheticScene& scene,
 }
 
 TEST(TrackerTest, TracksParkedAndTurningCarsWithoutIdentitySwitch) {
-  for (TrackerMode mode : {TrackerMode::kMht, TrackerMode::kIsm, TrackerMode::kVasm}) {
+  for (TrackerMode mode :
+       {TrackerMode::kMht, TrackerMode::kIsm, TrackerMode::kVasm, TrackerMode::kCv}) {
     SCOPED_TRACE(ToString(mode));
     SyntheticScene scene(SceneConfig{}, TwoCars(), 42);
     TrackerParams params;
@@ -102,6 +103,86 @@ TEST(TrackerTest, TracksParkedAndTurningCarsWithoutIdentitySwitch) {
       EXPECT_LT(RadToDeg(hrmse), 6.0);
     }
     EXPECT_EQ(tracker.scans_dropped(), 0);
+    // Scans only: the score is n / (n + confirm_updates) for n updates, 0.5 at confirmation.
+    for (const TrackReport& r : outs.back().tracks) {
+      const double n = r.num_updates, c = params.manager.confirm_updates;
+      EXPECT_NEAR(r.score, n / (n + c), 1e-12);
+      EXPECT_TRUE(std::isnan(r.z) && std::isnan(r.height));  // no box measured it
+      if (r.status == TrackStatus::kConfirmed) EXPECT_GE(r.score, 0.5);
+    }
+  }
+}
+
+// Fused input: the scans see both cars, a detector's boxes (the truth plus seeded noise, score 7)
+// only the turning one, each frame half a sweep after its scan. The detected car keeps one track
+// measured by both (its score is the boxes' score), and the car that only the scans see still
+// gets its track (its score from the scans, below 1); no other confirmed track appears.
+TEST(TrackerTest, FusedBoxesAndScansOfOneCarGiveOneTrackAndAScanOnlyCarStillGetsOne) {
+  for (TrackerMode mode : {TrackerMode::kMht, TrackerMode::kCv}) {
+    SCOPED_TRACE(ToString(mode));
+    SyntheticScene scene(SceneConfig{}, TwoCars(), 44);
+    TrackerParams params;
+    params.manager.mode = mode;
+    params.detections.mode = InputMode::kFused;
+    params.detections.min_score = 0.0;
+    params.detections.birth_score = 1.0;
+    Tracker tracker(params);
+    std::mt19937 rng(5);
+    std::normal_distribution<double> pos(0.0, 0.1), head(0.0, DegToRad(2.0));
+    std::vector<ScanOutput> outs;
+    std::int64_t seq = 0;
+    for (int tick = 0; tick <= 600; ++tick) {  // 6 s, poses at 100 Hz
+      const double t = tick * 0.01;
+      tracker.AddPose(scene.PoseAt(t), &outs);
+      if (tick < 10 || tick % 10 != 0) continue;
+      tracker.AddScan(scene.ScanAt(t - 0.1, seq), &outs);
+      const double td = t - 0.05;  // the frame's time: half a sweep after the scan's start
+      const OrientedBox b = scene.objects()[1].box_at(td);
+      const Eigen::Vector3d c = scene.EgoAt(td).inverse() * Eigen::Vector3d(b.center.x(), b.center.y(), 0.0);
+      DetectionList list;
+      list.utime = scene.Utime(td);
+      list.seq = seq++;
+      Detection d;
+      d.x = c.x() + pos(rng);
+      d.y = c.y() + pos(rng);
+      d.z = -1.7;
+      d.yaw = WrapToPi(b.theta + head(rng));  // the ego does not turn
+      d.length = b.length;
+      d.width = b.width;
+      d.height = 1.5;
+      d.score = 7.0;
+      list.boxes.push_back(d);
+      tracker.AddDetections(std::move(list), &outs);
+    }
+    tracker.Flush(&outs);
+    ASSERT_GE(outs.size(), 55u);
+    const Match m = Evaluate(outs, scene, 1.0);
+    for (int id : {1, 2}) {
+      SCOPED_TRACE(id);
+      EXPECT_EQ(m.missed.count(id) ? m.missed.at(id) : 0, 0);
+      ASSERT_TRUE(m.ids.count(id));
+      EXPECT_EQ(m.ids.at(id).size(), 1u) << "identity switch";
+    }
+    const std::int64_t parked_id = *m.ids.at(1).begin(), turning_id = *m.ids.at(2).begin();
+    EXPECT_NE(parked_id, turning_id);
+    int confirmed = 0, parked_updates = 0, turning_updates = 0;
+    for (const TrackReport& r : outs.back().tracks) {
+      if (r.status == TrackStatus::kTentative) continue;
+      ++confirmed;
+      if (r.id == turning_id) {
+        EXPECT_NEAR(r.score, 7.0, 1e-9);
+        turning_updates = r.num_updates;
+      }
+      if (r.id == parked_id) {
+        EXPECT_GT(r.score, 0.5);
+        EXPECT_LT(r.score, 1.0);
+        parked_updates = r.num_updates;
+      }
+    }
+    EXPECT_EQ(confirmed, 2);
+    // Measured by its boxes and by the scans: about twice the updates of the scan-only car.
+    EXPECT_GT(turning_updates, 3 * parked_updates / 2);
+    EXPECT_EQ(tracker.rejects().count("bad_detections"), 0u);
   }
 }
 

@@ -9,6 +9,9 @@
 
 namespace vtrack {
 
+// The tracker's finest range-profile bearing bin: 7200 bins per ring.
+inline constexpr double kMinRangeProfileBinDeg = 0.05;  // [deg]
+
 // The nearest return per bearing bin around the sensor, over every return of a scan, per ring of
 // a 3-D scanner. It tells whether a fitted face ends where the object ends (free space, or only
 // farther returns, just beyond the end: a full view of that face) or where something nearer

@@ -78,17 +78,21 @@ void OutlineExtractor::SortByBin(const PointSet& ps, const Eigen::Vector2d& s,
   // Bins uniform in tan(bearing - ref) (no atan2 per return; within +-30 deg of the segment's
   // middle, as wide as bin_rad to within 33%); the key orders by bin, then range^2.
   const double inv_res = 1.0 / std::tan(bin_rad);
-  keys_.clear();
-  bins_.clear();
+  const std::size_t size = ps.x.size();
+  keys_.resize(size);
+  bins_.resize(size);
   std::int64_t bin_lo = std::numeric_limits<std::int64_t>::max(), bin_hi = -bin_lo;
-  for (std::size_t k = 0; k < ps.x.size(); ++k) {
+  for (std::size_t k = 0; k < size; ++k) {
     const double dx = ps.x[k] - s.x(), dy = ps.y[k] - s.y();
     const double u = dx * ref.x() + dy * ref.y(), w = -dx * ref.y() + dy * ref.x();
     const double t = u > kMinAlong ? w / u : (w >= 0 ? kMaxTan : -kMaxTan);
-    const auto bin = static_cast<std::int64_t>(std::floor(std::clamp(t, -kMaxTan, kMaxTan) * inv_res));
+    // floor() without a library call: |v| <= kMaxTan * inv_res is far inside the int64 range.
+    const double v = std::clamp(t, -kMaxTan, kMaxTan) * inv_res;
+    auto bin = static_cast<std::int64_t>(v);  // rounds towards zero
+    if (static_cast<double>(bin) > v) --bin;
     const auto r2 = static_cast<std::int64_t>((dx * dx + dy * dy) * 1e4);  // [cm^2]
-    keys_.emplace_back(bin * kBinScale + r2, static_cast<std::int32_t>(k));
-    bins_.push_back(bin);
+    keys_[k] = {bin * kBinScale + r2, static_cast<std::int32_t>(k)};
+    bins_[k] = bin;
     bin_lo = std::min(bin_lo, bin);
     bin_hi = std::max(bin_hi, bin);
   }

@@ -33,15 +33,19 @@ class RangeProfile {
   bool FreeBeyond(const Eigen::Vector2d& end, const Eigen::Vector2d& inner, double margin,
                   int bins) const;
   bool empty() const { return nearest_.empty(); }
+  int num_bins() const { return num_bins_; }
+  int num_rings() const { return num_rings_; }
+  // [m] The nearest return of ring (in [0, num_rings())) in bearing bin (in [0, num_bins()),
+  // bin b from -180 deg + b * bin_deg); +inf if none.
+  float Nearest(int ring, int bin) const {
+    return nearest_[static_cast<std::size_t>(ring) * static_cast<std::size_t>(num_bins_) +
+                    static_cast<std::size_t>(bin)];
+  }
 
   static constexpr int kMaxRings = 256;
 
  private:
   int Bin(const Eigen::Vector2d& p) const;
-  float Nearest(int ring, int bin) const {
-    return nearest_[static_cast<std::size_t>(ring) * static_cast<std::size_t>(num_bins_) +
-                    static_cast<std::size_t>(bin)];
-  }
   Eigen::Vector2d sensor_ = Eigen::Vector2d::Zero();
   double inv_bin_ = 0.0;  // [1/rad]
   int num_bins_ = 0;

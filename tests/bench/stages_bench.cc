@@ -5,6 +5,10 @@
 //  - BM_Segmentation: grid connected components of the preprocessed returns;
 //  - BM_Association: prediction of every track to mid-sweep + association (gates, visible faces,
 //    split, Hungarian per component, merge) with the tracks of a tracker run up to that scan;
+//  - BM_RangeProfile: the per-ring range profile of the preprocessed returns (free space beyond a
+//    face's end, for the fit);
+//  - BM_Outlines: the outline of every track's associated returns and of every new object (the
+//    returns the fit sees), from that scan's association;
 //  - BM_HypothesisManagement: TrackManager::EndScan (confirmation, coasting, deletion,
 //    duplicates) + Report (selected hypothesis of every track predicted, planner trajectory),
 //    0.1 s after the scan, on a copy of the tracker's track manager after that scan.
@@ -13,6 +17,7 @@
 //   build/bench/stages_bench
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <memory>
 #include <vector>
 
@@ -29,6 +34,7 @@ struct StageInput {
   Segments segments;
   Eigen::Vector2d sensor_xy;
   std::vector<PredictedObject> predicted;
+  AssociationResult association;        // of predicted with segments
   std::unique_ptr<TrackManager> after;  // copy of the manager after the scan
 };
 
@@ -52,6 +58,7 @@ const Inputs& GetInputs() {
     r.tracker = std::make_unique<Tracker>(params);
     Preprocessor pre(params.preprocess);
     Segmenter seg(params.segmentation);
+    Associator assoc(params.association);
     std::vector<ScanOutput> out;
     const std::size_t last = std::min<std::size_t>(40, seq.scans.size());
     for (std::size_t i = 0; i < last; ++i) {
@@ -63,6 +70,7 @@ const Inputs& GetInputs() {
         seg.Run(f.points, false, f.sensor_xy, &f.segments);
         r.tracker->manager().Predict(seq.scans[i].utime + seq.scans[i].sweep_duration_us / 2,
                                      &f.predicted);
+        assoc.Run(f.predicted, f.points, f.segments, f.sensor_xy, &f.association);
         r.frames.push_back(std::move(f));
       }
       LadarScan copy = seq.scans[i];
@@ -130,6 +138,33 @@ void BM_Association(benchmark::State& state) {
   });
 }
 BENCHMARK(BM_Association)->Unit(benchmark::kMillisecond);
+
+void BM_RangeProfile(benchmark::State& state) {
+  const double bin_deg = std::max(kMinRangeProfileBinDeg, bench::ShippedParams().outline.bin_deg);
+  RangeProfile profile;
+  ForEachScanCounting(state, "returns", [&](const Inputs&, const StageInput& f) {
+    profile.Build(f.sensor_xy, f.points.x, f.points.y, f.points.ring, bin_deg);
+    return static_cast<double>(f.points.size());
+  });
+}
+BENCHMARK(BM_RangeProfile)->Unit(benchmark::kMillisecond);
+
+void BM_Outlines(benchmark::State& state) {
+  OutlineExtractor outline(bench::ShippedParams().outline);
+  PointSet ps;
+  ForEachScanCounting(state, "outlines", [&](const Inputs&, const StageInput& f) {
+    int n = 0;
+    for (const auto* lists : {&f.association.track_points, &f.association.new_objects}) {
+      for (const auto& idx : *lists) {
+        if (idx.empty()) continue;
+        outline.Extract(f.points, idx, *f.scan, f.sensor_xy, &ps);
+        ++n;
+      }
+    }
+    return static_cast<double>(n);
+  });
+}
+BENCHMARK(BM_Outlines)->Unit(benchmark::kMillisecond);
 
 void BM_HypothesisManagement(benchmark::State& state) {
   std::vector<TrackReport> reports;

@@ -568,12 +568,12 @@ std::array<CornerHypothesis, 3> CornerHypothesesFromPoints(const Eigen::Vector2d
   return out;
 }
 
-bool CornerVisible(const CornerHypothesis& h, const Eigen::Vector2d& sensor_xy,
-                   double min_slant_rad) {
-  if (h.degenerate) return false;
-  const Eigen::Vector2d view = h.corner - sensor_xy;
-  if (view.squaredNorm() == 0.0) return false;
-  // Eq. (15).
+namespace {
+
+// Eq. (15) as written: the bearing of the view within limit of both edge directions (and of the
+// reverse of a, when a runs both ways).
+bool CornerVisibleByAngles(const CornerHypothesis& h, const Eigen::Vector2d& view,
+                           double min_slant_rad) {
   const double theta_c = AngleOf(view);
   const double theta_a = AngleOf(h.dir_a), theta_b = AngleOf(h.dir_b);
   const double limit = 0.5 * kPi - min_slant_rad;
@@ -583,13 +583,59 @@ bool CornerVisible(const CornerHypothesis& h, const Eigen::Vector2d& sensor_xy,
   return visible;
 }
 
+enum class Clear { kYes, kNo, kUnsure };
+
+// Whether the angle between u and v is below limit, without atan2: for limit in (0, pi/2] it
+// is iff u.v > 0 and |u x v| < u.v tan(limit). kUnsure within a relative 1e-9 of that boundary
+// (far beyond the rounding of this or the atan2 form) and for a zero vector.
+Clear AngleBelow(const Eigen::Vector2d& u, const Eigen::Vector2d& v, double tan_limit) {
+  constexpr double kMargin = 1e-9;
+  const double dot = u.dot(v), cross = std::abs(u.x() * v.y() - u.y() * v.x());
+  const double scale = u.norm() * v.norm();
+  if (!(scale > 0.0)) return Clear::kUnsure;
+  if (dot > kMargin * scale) {
+    const double bound = dot * tan_limit;
+    if (cross < bound * (1.0 - kMargin)) return Clear::kYes;
+    if (cross > bound * (1.0 + kMargin)) return Clear::kNo;
+  } else if (dot < -kMargin * scale) {
+    return Clear::kNo;
+  }
+  return Clear::kUnsure;
+}
+
+}  // namespace
+
+bool CornerVisible(const CornerHypothesis& h, const Eigen::Vector2d& sensor_xy,
+                   double min_slant_rad) {
+  if (h.degenerate) return false;
+  const Eigen::Vector2d view = h.corner - sensor_xy;
+  if (view.squaredNorm() == 0.0) return false;
+  // Eq. (15) by dot and cross products (three atan2 and remainders were a visible share of a
+  // KITTI sweep); where any test is not clear, the angles themselves, so the answer is always
+  // CornerVisibleByAngles'.
+  const double limit = 0.5 * kPi - min_slant_rad;
+  if (!(limit > 0.0 && limit <= 0.5 * kPi)) return CornerVisibleByAngles(h, view, min_slant_rad);
+  const double tan_limit = std::tan(limit);
+  const Clear a = AngleBelow(view, h.dir_a, tan_limit), b = AngleBelow(view, h.dir_b, tan_limit);
+  const Clear c = h.a_both_ways ? AngleBelow(view, -h.dir_a, tan_limit) : Clear::kYes;
+  if (a == Clear::kUnsure || b == Clear::kUnsure || c == Clear::kUnsure) {
+    return CornerVisibleByAngles(h, view, min_slant_rad);
+  }
+  return a == Clear::kYes && b == Clear::kYes && c == Clear::kYes;
+}
+
 bool EdgeVisible(const Eigen::Vector2d& point, const Eigen::Vector2d& dir,
                  const Eigen::Vector2d& sensor_xy, double min_slant_rad) {
   const Eigen::Vector2d to_sensor = sensor_xy - point;
   if (to_sensor.squaredNorm() == 0.0 || dir.squaredNorm() == 0.0) return false;
   Eigen::Vector2d normal = Perp(dir);
   if (normal.dot(to_sensor) < 0.0) normal = -normal;
-  return std::abs(AngleDiff(AngleOf(normal), AngleOf(to_sensor))) < 0.5 * kPi - min_slant_rad;
+  const double limit = 0.5 * kPi - min_slant_rad;
+  if (limit > 0.0 && limit <= 0.5 * kPi) {  // as in CornerVisible: the angles where not clear
+    const Clear c = AngleBelow(normal, to_sensor, std::tan(limit));
+    if (c != Clear::kUnsure) return c == Clear::kYes;
+  }
+  return std::abs(AngleDiff(AngleOf(normal), AngleOf(to_sensor))) < limit;
 }
 
 SegmentFitter::SegmentFitter(const FitParams& params) : params_(params) {

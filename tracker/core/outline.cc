@@ -78,16 +78,66 @@ void OutlineExtractor::SortByBin(const PointSet& ps, const Eigen::Vector2d& s,
   // Bins uniform in tan(bearing - ref) (no atan2 per return; within +-30 deg of the segment's
   // middle, as wide as bin_rad to within 33%); the key orders by bin, then range^2.
   const double inv_res = 1.0 / std::tan(bin_rad);
-  keys_.clear();
-  for (std::size_t k = 0; k < ps.x.size(); ++k) {
+  const std::size_t size = ps.x.size();
+  keys_.resize(size);
+  bins_.resize(size);
+  std::int64_t bin_lo = std::numeric_limits<std::int64_t>::max(), bin_hi = -bin_lo;
+  for (std::size_t k = 0; k < size; ++k) {
     const double dx = ps.x[k] - s.x(), dy = ps.y[k] - s.y();
     const double u = dx * ref.x() + dy * ref.y(), w = -dx * ref.y() + dy * ref.x();
     const double t = u > kMinAlong ? w / u : (w >= 0 ? kMaxTan : -kMaxTan);
-    const auto bin = static_cast<std::int64_t>(std::floor(std::clamp(t, -kMaxTan, kMaxTan) * inv_res));
+    // floor() without a library call: |v| <= kMaxTan * inv_res is far inside the int64 range.
+    const double v = std::clamp(t, -kMaxTan, kMaxTan) * inv_res;
+    auto bin = static_cast<std::int64_t>(v);  // rounds towards zero
+    if (static_cast<double>(bin) > v) --bin;
     const auto r2 = static_cast<std::int64_t>((dx * dx + dy * dy) * 1e4);  // [cm^2]
-    keys_.emplace_back(bin * kBinScale + r2, static_cast<std::int32_t>(k));
+    keys_[k] = {bin * kBinScale + r2, static_cast<std::int32_t>(k)};
+    bins_[k] = bin;
+    bin_lo = std::min(bin_lo, bin);
+    bin_hi = std::max(bin_hi, bin);
   }
-  std::sort(keys_.begin(), keys_.end());
+  if (keys_.size() < 2) return;
+  // The keys are distinct (k is), so any correct sort gives std::sort's order. A segment's
+  // returns fill a few dozen neighbouring bins of a few returns each: a counting sort by bin
+  // (stable, so k ascending within a bin), then an insertion sort of each bin by key, costs
+  // about n steps instead of n log n comparisons. Returns beside or behind the sensor (bins
+  // far apart) take std::sort.
+  const auto n = static_cast<std::int64_t>(keys_.size());
+  if (bin_hi - bin_lo > 4 * n + 256) {
+    std::sort(keys_.begin(), keys_.end());
+    return;
+  }
+  bin_end_.assign(static_cast<std::size_t>(bin_hi - bin_lo + 2), 0);
+  for (const std::int64_t b : bins_) ++bin_end_[static_cast<std::size_t>(b - bin_lo + 1)];
+  for (std::size_t i = 1; i < bin_end_.size(); ++i) bin_end_[i] += bin_end_[i - 1];
+  sorted_keys_.resize(keys_.size());
+  for (std::size_t k = 0; k < keys_.size(); ++k) {
+    sorted_keys_[bin_end_[static_cast<std::size_t>(bins_[k] - bin_lo)]++] = keys_[k];
+  }
+  // bin_end_[i] is now the end of bin i and the start of bin i + 1.
+  std::size_t begin = 0;
+  for (std::size_t i = 0; i + 1 < bin_end_.size(); ++i) {
+    const std::size_t end = bin_end_[i];
+    SortBin(begin, end);
+    begin = end;
+  }
+  keys_.swap(sorted_keys_);
+}
+
+void OutlineExtractor::SortBin(std::size_t begin, std::size_t end) {
+  constexpr std::size_t kInsertionMax = 24;  // longer bins: std::sort (n^2 / 4 moves)
+  auto* a = sorted_keys_.data();
+  if (end - begin > kInsertionMax) {
+    std::sort(a + begin, a + end);
+    return;
+  }
+  // Entries arrive in k order: moving only past strictly larger keys keeps ties by k.
+  for (std::size_t i = begin + 1; i < end; ++i) {
+    const auto v = a[i];
+    std::size_t j = i;
+    for (; j > begin && a[j - 1].first > v.first; --j) a[j] = a[j - 1];
+    a[j] = v;
+  }
 }
 
 double OutlineExtractor::RangeOf(std::size_t a) const {

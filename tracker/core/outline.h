@@ -49,6 +49,8 @@ class OutlineExtractor {
   // Sorts the returns by bearing bin, then range, into keys_.
   void SortByBin(const PointSet& ps, const Eigen::Vector2d& sensor, const Eigen::Vector2d& ref,
                  double bin_rad);
+  // Sorts sorted_keys_[begin, end), in k order, by key.
+  void SortBin(std::size_t begin, std::size_t end);
   // Appends to outline_x_/y_ per bin the nearest return with support (support_height > 0), or
   // the nearest return (support_height 0).
   void PickPerBin(const WorldPoints& points, const std::vector<std::int32_t>& idx,
@@ -61,6 +63,9 @@ class OutlineExtractor {
   OutlineParams params_;
   // Scratch reused from segment to segment.
   std::vector<std::pair<std::int64_t, std::int32_t>> keys_;  // (bin * 2^32 + range^2 [cm^2], k)
+  std::vector<std::pair<std::int64_t, std::int32_t>> sorted_keys_;
+  std::vector<std::int64_t> bins_;       // bin of keys_[k]
+  std::vector<std::uint32_t> bin_end_;   // counting sort: per bin (from the lowest) its end
   std::vector<float> outline_x_, outline_y_;
   struct RingSpan {
     std::int16_t ring;

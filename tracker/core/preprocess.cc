@@ -208,10 +208,11 @@ void Preprocessor::Compensate(const LadarScan& scan, PreprocessStats* stats, Wor
                                      : 0.0;
     const auto& m = knot_m_[static_cast<std::size_t>(k)];
     const auto& d = knot_d_[static_cast<std::size_t>(k)];
-    const double wx = (m(0, 0) + f * d(0, 0)) * px + (m(0, 1) + f * d(0, 1)) * py +
-                      (m(0, 2) + f * d(0, 2)) * pz + (m(0, 3) + f * d(0, 3));
-    const double wy = (m(1, 0) + f * d(1, 0)) * px + (m(1, 1) + f * d(1, 1)) * py +
-                      (m(1, 2) + f * d(1, 2)) * pz + (m(1, 3) + f * d(1, 3));
+    // Both rows at once: a column of a 2x4 matrix is one SIMD pair, and each row gets the
+    // operations a row written out would, in the same order (the same doubles).
+    const Eigen::Vector2d wxy = (m.col(0) + f * d.col(0)) * px + (m.col(1) + f * d.col(1)) * py +
+                                (m.col(2) + f * d.col(2)) * pz + (m.col(3) + f * d.col(3));
+    const double wx = wxy.x(), wy = wxy.y();
     const double zb = body_z(0) * px + body_z(1) * py + body_z(2) * pz + body_z(3);
     ox[w] = wx;
     oy[w] = wy;

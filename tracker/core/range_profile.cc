@@ -24,8 +24,11 @@ void RangeProfile::Build(const Eigen::Vector2d& sensor_xy, const std::vector<dou
   auto ring_of = [&](std::size_t i) {
     return rings ? std::clamp<int>(ring[i], 0, kMaxRings - 1) : 0;
   };
+  // The largest ring, clamped (clamping is monotone: the same as the largest clamped ring).
   num_rings_ = 1;
-  for (std::size_t i = 0; rings && i < x.size(); ++i) num_rings_ = std::max(num_rings_, ring_of(i) + 1);
+  if (rings && !ring.empty()) {
+    num_rings_ = std::clamp<int>(*std::max_element(ring.begin(), ring.end()), 0, kMaxRings - 1) + 1;
+  }
   nearest_.assign(static_cast<std::size_t>(num_rings_) * static_cast<std::size_t>(num_bins_),
                   std::numeric_limits<float>::infinity());
   // The bin Bin() gives, with Atan2Approx wherever its error bound (with ample slack for the
@@ -36,12 +39,13 @@ void RangeProfile::Build(const Eigen::Vector2d& sensor_xy, const std::vector<dou
     const Eigen::Vector2d p(x[i], y[i]);
     const Eigen::Vector2d d = p - sensor_;
     const double v = (Atan2Approx(d.y(), d.x()) + kPi) * inv_bin_;
-    const double lo = std::floor(v - slack);
-    int b;
-    if (lo == std::floor(v + slack)) {
-      b = static_cast<int>(lo);  // in [-1, n]: the wrap of Bin() without its two divisions
-      if (b < 0) b += n;
-      else if (b >= n) b -= n;
+    // v is in [-slack, n + slack]: the cast is floor(v) for v >= 0, and v - b is exact. The
+    // interval v +- slack inside one bin: that bin (n wraps to 0 as in Bin(), without its two
+    // divisions); else Bin() itself (v < 0 included).
+    int b = static_cast<int>(v);
+    const double frac = v - b;
+    if (frac >= slack && frac < 1.0 - slack) {
+      if (b >= n) b -= n;
     } else {
       b = Bin(p);
     }

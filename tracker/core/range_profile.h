@@ -9,6 +9,9 @@
 
 namespace vtrack {
 
+// The tracker's finest range-profile bearing bin: 7200 bins per ring.
+inline constexpr double kMinRangeProfileBinDeg = 0.05;  // [deg]
+
 // The nearest return per bearing bin around the sensor, over every return of a scan, per ring of
 // a 3-D scanner. It tells whether a fitted face ends where the object ends (free space, or only
 // farther returns, just beyond the end: a full view of that face) or where something nearer
@@ -34,15 +37,19 @@ class RangeProfile {
   // seen, and the face must not be taken for a full view.
   void MarkUnseen(double begin, double end);
   bool empty() const { return nearest_.empty(); }
+  int num_bins() const { return num_bins_; }
+  int num_rings() const { return num_rings_; }
+  // [m] The nearest return of ring (in [0, num_rings())) in bearing bin (in [0, num_bins()),
+  // bin b from -180 deg + b * bin_deg); +inf if none.
+  float Nearest(int ring, int bin) const {
+    return nearest_[static_cast<std::size_t>(ring) * static_cast<std::size_t>(num_bins_) +
+                    static_cast<std::size_t>(bin)];
+  }
 
   static constexpr int kMaxRings = 256;
 
  private:
   int Bin(const Eigen::Vector2d& p) const;
-  float Nearest(int ring, int bin) const {
-    return nearest_[static_cast<std::size_t>(ring) * static_cast<std::size_t>(num_bins_) +
-                    static_cast<std::size_t>(bin)];
-  }
   Eigen::Vector2d sensor_ = Eigen::Vector2d::Zero();
   double inv_bin_ = 0.0;  // [1/rad]
   int num_bins_ = 0;

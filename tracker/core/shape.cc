@@ -75,13 +75,20 @@ std::optional<double> DimensionHistogram::Estimate() const {
   if (empty_ || total_ <= 0.0) return std::nullopt;
   const int n = static_cast<int>(bins_.size());
   const double bw = params_.bin_width;
+  // Only bins [i0, i1] hold weight (a track's samples span a few dozen of the hundreds of bins):
+  // the steps below skip the empty ends, where nothing changes (no quantile step, a smoothed
+  // value of exactly 0, no peak).
+  int i0 = 0, i1 = n - 1;
+  while (i0 < n && bins_[i0] == 0.0) ++i0;
+  if (i0 == n) return std::nullopt;  // only samples above the range: no peak (as in step 3)
+  while (bins_[i1] == 0.0) --i1;
 
   // 1. The (1 - excluded_fraction) weighted quantile, weight spread evenly within a bin.
   double cutoff = params_.max_dimension;
   {
     const double excluded = params_.excluded_fraction * total_;
     double above = overflow_;
-    for (int i = n - 1; i >= 0 && above < excluded; --i) {
+    for (int i = i1; i >= i0 && above < excluded; --i) {
       if (above + bins_[i] >= excluded) {
         cutoff = (i + 1.0 - (excluded - above) / bins_[i]) * bw;
       }
@@ -89,40 +96,42 @@ std::optional<double> DimensionHistogram::Estimate() const {
     }
   }
 
-  // 2. Smoothed histogram.
+  // 2. Smoothed histogram, over the bins within the kernel's reach of [i0, i1]: s_[i - lo].
   const int half = static_cast<int>(kernel_.size() / 2);
-  std::vector<double> s(n, 0.0);
-  for (int i = 0; i < n; ++i) {
+  const int lo = std::max(0, i0 - half), hi = std::min(n - 1, i1 + half);
+  std::vector<double> s(static_cast<std::size_t>(hi - lo + 1), 0.0);
+  for (int i = i0; i <= i1; ++i) {
     if (bins_[i] == 0.0) continue;
     const int k0 = std::max(-half, -i), k1 = std::min(half, n - 1 - i);
-    for (int k = k0; k <= k1; ++k) s[i + k] += bins_[i] * kernel_[k + half];
+    for (int k = k0; k <= k1; ++k) s[i + k - lo] += bins_[i] * kernel_[k + half];
   }
+  auto at = [&](int i) { return i < lo || i > hi ? 0.0 : s[i - lo]; };
 
   // 3. Eligible local maxima (centre at or below the cutoff), the highest of them, then the
   // longest one of at least min_peak_fraction of that height.
   auto is_peak = [&](int i) {
-    return s[i] > 0.0 && (i == 0 || s[i] > s[i - 1]) && (i == n - 1 || s[i] >= s[i + 1]) &&
+    return at(i) > 0.0 && (i == 0 || at(i) > at(i - 1)) && (i == n - 1 || at(i) >= at(i + 1)) &&
            (i + 0.5) * bw <= cutoff;
   };
   double highest = 0.0;
-  for (int i = 0; i < n; ++i) {
-    if (is_peak(i)) highest = std::max(highest, s[i]);
+  for (int i = lo; i <= hi; ++i) {
+    if (is_peak(i)) highest = std::max(highest, at(i));
   }
   if (highest <= 0.0) {
     // Every sample lies in the excluded top or above the range: nothing to choose from.
     return std::nullopt;
   }
   int chosen = -1;
-  for (int i = n - 1; i >= 0 && chosen < 0; --i) {
-    if (is_peak(i) && s[i] >= params_.min_peak_fraction * highest) chosen = i;
+  for (int i = hi; i >= lo && chosen < 0; --i) {
+    if (is_peak(i) && at(i) >= params_.min_peak_fraction * highest) chosen = i;
   }
 
   // Vertex of the parabola through the chosen bin and its neighbours, within half a bin.
   double offset = 0.0;
   if (chosen > 0 && chosen < n - 1) {
-    const double curvature = s[chosen - 1] - 2.0 * s[chosen] + s[chosen + 1];
+    const double curvature = at(chosen - 1) - 2.0 * at(chosen) + at(chosen + 1);
     if (curvature < 0.0) {
-      offset = std::clamp(0.5 * (s[chosen - 1] - s[chosen + 1]) / curvature, -0.5, 0.5);
+      offset = std::clamp(0.5 * (at(chosen - 1) - at(chosen + 1)) / curvature, -0.5, 0.5);
     }
   }
   return (chosen + 0.5 + offset) * bw;

@@ -460,8 +460,10 @@ void TrackManager::Report(std::int64_t utime, std::vector<TrackReport>* out) con
       r.length = *sel.length_est;
       r.width = *sel.width_est;
     }
-    r.prediction = ekf_.PredictTrajectory(h, params_.prediction_horizon_s,
-                                          params_.prediction_step_s, sel.noise_scale);
+    if (params_.predict_all_tracks || r.object_class == ObjectClass::kVehicle) {
+      r.prediction = ekf_.PredictTrajectory(h, params_.prediction_horizon_s,
+                                            params_.prediction_step_s, sel.noise_scale);
+    }
     out->push_back(std::move(r));
   }
 }

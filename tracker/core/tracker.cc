@@ -14,9 +14,6 @@ namespace {
 
 std::string Str(std::int64_t v) { return std::to_string(v); }
 
-// The range profile's finest bearing bin: 7200 bins per ring.
-constexpr double kMinProfileBinDeg = 0.05;  // [deg]
-
 // The seed of the RANSAC fits of one track (salt: its id; a new object: -1 - its index): a
 // function of the scan and the track only, so that reruns are identical.
 std::uint64_t RansacSeed(std::int64_t scan_utime, std::int64_t salt) {
@@ -241,7 +238,7 @@ void Tracker::UpdateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_
   const bool multi_ring = scan.num_rings > 1;
   if (multi_ring) {
     profile_.Build(sensor_xy, points_.x, points_.y, points_.ring,
-                   std::max(kMinProfileBinDeg, params_.outline.bin_deg));
+                   std::max(kMinRangeProfileBinDeg, params_.outline.bin_deg));
     for (const AzimuthWedge& w : lost_world_) profile_.MarkUnseen(w.begin, w.end);
   }
   const std::size_t num_tracks = manager_->tracks().size();

@@ -150,6 +150,47 @@ TEST(Fitting, EdgeVisibleMatchesDotProductForm) {
   }
 }
 
+// CornerVisible decides by dot and cross products where that is clear and by the angles of
+// Eq. (15) near the limit: the answer must be the angles' one also for views on the limit or
+// within 1e-18 to 1e-6 rad of it on either side, for corners whose edge a runs both ways, and for slants
+// of 0 (a limit of exactly 90 deg). Reference: Eq. (15) written out here with std::atan2.
+TEST(Fitting, CornerVisibleIsEquation15AlsoAtTheLimit) {
+  auto eq15 = [](const CornerHypothesis& h, const Eigen::Vector2d& sensor, double slant) {
+    const Eigen::Vector2d v = h.corner - sensor;
+    const double tc = std::atan2(v.y(), v.x()), ta = std::atan2(h.dir_a.y(), h.dir_a.x()),
+                 tb = std::atan2(h.dir_b.y(), h.dir_b.x()), lim = 0.5 * kPi - slant;
+    auto diff = [](double x, double y) { return std::abs(std::remainder(x - y, 2.0 * kPi)); };
+    return diff(tc, ta) < lim && diff(tc, tb) < lim && (!h.a_both_ways || diff(tc, ta + kPi) < lim);
+  };
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int visible = 0, checked = 0;
+  for (const double slant : {0.0, kSlant, DegToRad(30.0)}) {
+    for (int i = 0; i < 4000; ++i) {
+      CornerHypothesis h;
+      h.degenerate = false;
+      h.corner = Eigen::Vector2d(20 * u(rng), 20 * u(rng));
+      const double a = kPi * u(rng);
+      h.dir_a = Eigen::Vector2d(std::cos(a), std::sin(a));
+      h.dir_b = (u(rng) > 0 ? 1.0 : -1.0) * Eigen::Vector2d(-h.dir_a.y(), h.dir_a.x());
+      h.a_both_ways = i % 5 == 0;
+      // The view at the limit from edge a or b, off by 0 or +-10^-18..10^-6 rad, at 1..50 m.
+      const double off = i % 7 == 0 ? 0.0
+                                    : std::pow(10.0, -18.0 + 12.0 * (0.5 + 0.5 * u(rng))) * (u(rng) > 0 ? 1 : -1);
+      const Eigen::Vector2d& edge = i % 2 ? h.dir_a : h.dir_b;
+      const double view = std::atan2(edge.y(), edge.x()) + (u(rng) > 0 ? 1 : -1) * (0.5 * kPi - slant + off);
+      const double r = 1.0 + 49.0 * (0.5 + 0.5 * u(rng));
+      const Eigen::Vector2d sensor = h.corner - r * Eigen::Vector2d(std::cos(view), std::sin(view));
+      const bool expected = eq15(h, sensor, slant);
+      EXPECT_EQ(CornerVisible(h, sensor, slant), expected) << slant << " " << i;
+      visible += expected;
+      ++checked;
+    }
+  }
+  EXPECT_GT(visible, checked / 10);
+  EXPECT_LT(visible, checked * 9 / 10);
+}
+
 TEST(Fitting, CornerHypothesesArePerpendicularFeet) {
   std::mt19937 rng(13);
   std::uniform_real_distribution<double> u(-5.0, 5.0);

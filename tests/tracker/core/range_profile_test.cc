@@ -8,6 +8,8 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <random>
 #include <vector>
 
 #include "base/angle.h"
@@ -105,6 +107,49 @@ TEST(RangeProfileTest, RingsOutsideTheTableShareTheLastAndNegativeOnesTheFirst) 
   c.Add(4.0, 0.0, -3);
   c.Add(4.0, 0.1, 30000);
   EXPECT_TRUE(LeftEndFree(PerRing(c)));
+}
+
+// Build() finds bins with a fast bearing and falls back to std::atan2 near bin edges: every
+// return must land in the bin std::atan2 gives, also returns exactly on bin edges and at
+// +-180 deg. Reference: per (ring, bin) the nearest range, binned with std::atan2 here.
+TEST(RangeProfileTest, BinsAreThoseOfStdAtan2AlsoOnBinEdges) {
+  const Eigen::Vector2d sensor(3.25, -7.5);
+  constexpr int kRings = 4;
+  for (const double bin_deg : {0.05, 0.2, 1.0}) {
+    SCOPED_TRACE(bin_deg);
+    const int n = static_cast<int>(std::ceil(360.0 / bin_deg));
+    const double w = 2.0 * kPi / n;  // [rad]
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> bearing(-kPi, kPi), range(1.0, 80.0);
+    std::vector<double> x, y, bearings;
+    std::vector<std::int16_t> ring;
+    for (int i = 0; i < 20000; ++i) bearings.push_back(bearing(rng));
+    for (int b = 0; b <= n; b += 7) bearings.push_back(-kPi + b * w);  // on the edges
+    bearings.push_back(kPi);
+    for (std::size_t i = 0; i < bearings.size(); ++i) {
+      const double r = range(rng);
+      x.push_back(sensor.x() + r * std::cos(bearings[i]));
+      y.push_back(sensor.y() + r * std::sin(bearings[i]));
+      ring.push_back(static_cast<std::int16_t>(i % kRings));
+    }
+    std::vector<float> want(static_cast<std::size_t>(kRings * n), std::numeric_limits<float>::infinity());
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      const double dx = x[i] - sensor.x(), dy = y[i] - sensor.y();
+      int b = static_cast<int>(std::floor((std::atan2(dy, dx) + kPi) * (n / (2.0 * kPi))));
+      b = ((b % n) + n) % n;
+      float& f = want[static_cast<std::size_t>(ring[i] * n + b)];
+      f = std::min(f, static_cast<float>(std::hypot(dx, dy)));
+    }
+    RangeProfile p;
+    p.Build(sensor, x, y, ring, bin_deg);
+    ASSERT_EQ(p.num_bins(), n);
+    ASSERT_EQ(p.num_rings(), kRings);
+    int differ = 0;
+    for (int r = 0; r < kRings; ++r) {
+      for (int b = 0; b < n; ++b) differ += p.Nearest(r, b) != want[static_cast<std::size_t>(r * n + b)];
+    }
+    EXPECT_EQ(differ, 0);
+  }
 }
 
 }  // namespace

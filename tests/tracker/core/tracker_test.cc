@@ -223,6 +223,43 @@ TEST(TrackerTest, MoversGainVasmHypothesesAndStationaryObjectsKeepOneIsm) {
   EXPECT_EQ(checked, 2);
 }
 
+// The trajectory is for the planner, which acts on vehicles: by default only vehicle tracks carry
+// one; manager.predict_all_tracks gives every track one, and changes nothing else.
+TEST(TrackerTest, PredictsVehiclesOnlyUnlessAllTracksAreAsked) {
+  auto run = [](bool all) {
+    SyntheticScene scene(SceneConfig{}, TwoCars(), 44);
+    TrackerParams params;
+    params.manager.predict_all_tracks = all;
+    Tracker tracker(params);
+    return RunScene(&tracker, &scene, 4.0);
+  };
+  const auto vehicles_only = run(false), all = run(true);
+  ASSERT_EQ(vehicles_only.size(), all.size());
+  int vehicles = 0, others = 0;
+  for (std::size_t s = 0; s < all.size(); ++s) {
+    ASSERT_EQ(vehicles_only[s].tracks.size(), all[s].tracks.size());
+    for (std::size_t k = 0; k < all[s].tracks.size(); ++k) {
+      const TrackReport& a = all[s].tracks[k];
+      const TrackReport& v = vehicles_only[s].tracks[k];
+      EXPECT_EQ(a.id, v.id);
+      EXPECT_EQ(a.x, v.x);
+      EXPECT_EQ(a.theta, v.theta);
+      ASSERT_EQ(a.prediction.size(), 31u);  // 0..3 s by 0.1 s
+      if (a.object_class == ObjectClass::kVehicle) {
+        ++vehicles;
+        ASSERT_EQ(v.prediction.size(), a.prediction.size());
+        EXPECT_EQ(v.prediction.back().pose, a.prediction.back().pose);
+      } else {
+        ++others;
+        EXPECT_TRUE(v.prediction.empty());
+      }
+    }
+  }
+  // Both kinds occur: new tracks are not vehicles until their size is known.
+  EXPECT_GT(vehicles, 0);
+  EXPECT_GT(others, 0);
+}
+
 TEST(TrackerTest, SameInputGivesIdenticalOutput) {
   auto run = [] {
     SyntheticScene scene(SceneConfig{}, TwoCars(), 44);

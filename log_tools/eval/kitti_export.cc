@@ -68,7 +68,11 @@ KittiExportStats ExportKittiTracking(const LogData& data, const std::string& mod
     for (const auto& tr : list.tracks) {
       const bool status_ok = tr.status == vtrack::track_t::STATUS_CONFIRMED ||
                              (params.score_coasting && tr.status == vtrack::track_t::STATUS_COASTING);
-      if (!status_ok || tr.object_class != vtrack::track_t::CLASS_VEHICLE) continue;
+      // Vehicles, and every track a detector's box measured (height finite) whatever its class:
+      // the tracker calls a box track a vehicle only from a confident score, while the KITTI
+      // criterion sweeps the score threshold itself (sAMOTA), so the weak ones go out ranked by it.
+      const bool box_measured = std::isfinite(tr.height);
+      if (!status_ok || (tr.object_class != vtrack::track_t::CLASS_VEHICLE && !box_measured)) continue;
       const double dt = stats.time_offset_s;
       const double speed = std::isfinite(tr.speed) ? tr.speed : 0.0;
       const double vh = std::isfinite(tr.velocity_heading) ? tr.velocity_heading : tr.theta;

@@ -171,6 +171,10 @@ TEST_F(EvalCliTest, KittiExportTakesATracksBottomAndHeightFromItsBoxes) {
       ASSERT_EQ(lcm_util::Decode(ev->data, static_cast<std::size_t>(ev->datalen), &m),
                 lcm_util::DecodeError::kNone);
       for (auto& t : m.tracks) {
+        if (t.id == 3) {  // classed other but measured by boxes: exported too
+          t.z = -1.5;
+          t.height = 1.4;
+        }
         if (t.id != 2) continue;
         t.z = -1.2;
         t.height = 1.9;
@@ -183,7 +187,7 @@ TEST_F(EvalCliTest, KittiExportTakesATracksBottomAndHeightFromItsBoxes) {
   ASSERT_EQ(RunTool({run_, tracks_z, "--kitti-calib", calib, "--kitti-out", out_file,
                      "--kitti-image-size", "1200x360"}, &out), 0) << out;
   std::ifstream in(out_file);
-  int b_lines = 0, other_lines = 0;
+  int b_lines = 0, other_lines = 0, boxed_other_lines = 0;
   for (std::string l; std::getline(in, l);) {
     std::istringstream ss(l);
     long long frame = 0, id = 0;
@@ -197,6 +201,9 @@ TEST_F(EvalCliTest, KittiExportTakesATracksBottomAndHeightFromItsBoxes) {
       EXPECT_NEAR(y, 1.2, 1e-5);
       EXPECT_NEAR(z, 10.0, 1e-5);
       EXPECT_NEAR(h, 1.9, 1e-9);
+    } else if (id == 3) {
+      ++boxed_other_lines;
+      EXPECT_NEAR(h, 1.4, 1e-9) << l;
     } else {
       ++other_lines;
       EXPECT_NEAR(y, 1.73, 1e-5) << l;  // no box measured it: on the road
@@ -205,6 +212,7 @@ TEST_F(EvalCliTest, KittiExportTakesATracksBottomAndHeightFromItsBoxes) {
   }
   EXPECT_EQ(b_lines, kScans);
   EXPECT_GT(other_lines, 0);
+  EXPECT_GT(boxed_other_lines, 0);  // a box track of low score: its class other, still exported
 }
 
 }  // namespace

@@ -40,6 +40,8 @@ vtrack::track_t Track(std::int64_t id, std::int8_t status, std::int8_t cls, doub
   t.y = y;
   t.theta = theta;
   t.rear_axle_offset = kNaN;
+  t.z = kNaN;  // no detector's box measured it (track_t)
+  t.height = kNaN;
   t.length = 4.5;
   t.width = 1.8;
   for (int i = 0; i < 9; ++i) t.cov[i] = 0.0;

@@ -31,16 +31,20 @@ std::optional<bool> MoverTest::Evidence(const Ekf& ekf, const Track& t, bool pos
 }
 
 ObjectClass Classify(const TrackManagerParams& params, const Track& t, bool vehicle_needs_box,
-                     std::int64_t utime) {
+                     std::int64_t utime, double vehicle_box_score) {
   if (t.small_object) return ObjectClass::kOther;
+  // A track a detector's box measured is a vehicle if its boxes are, on average, as confident as
+  // one that may start a track (vehicle_box_score = detections.birth_score); weaker ones stay
+  // tracked, scored and exported (the KITTI criterion sweeps the score itself).
+  const bool confident = t.box_score >= vehicle_box_score;
   if (vehicle_needs_box) {
-    // The detector is the vehicle evidence: a vehicle while the boxes alone would keep it a
-    // confirmed track (confirm_updates boxes, the latest within coast_max_s).
+    // Fused: the detector is the vehicle evidence: a vehicle while the boxes alone would keep it
+    // a confirmed track (confirm_updates boxes, the latest within coast_max_s).
     const double since_box_s = static_cast<double>(utime - t.last_box_utime) * 1e-6;
     const bool box_track = t.box_updates >= params.confirm_updates && since_box_s <= params.coast_max_s;
-    return box_track ? ObjectClass::kVehicle : ObjectClass::kOther;
+    return box_track && confident ? ObjectClass::kVehicle : ObjectClass::kOther;
   }
-  if (t.box_updates > 0) return ObjectClass::kVehicle;
+  if (t.box_updates > 0) return confident ? ObjectClass::kVehicle : ObjectClass::kOther;
   const TrackHypothesis& sel = t.hyps[static_cast<std::size_t>(t.selected)];
   const double est_l = sel.length_est.value_or(0.0), est_w = sel.width_est.value_or(0.0);
   const bool vehicle_size = est_l <= params.vehicle_max_length &&

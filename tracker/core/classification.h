@@ -2,6 +2,7 @@
 // (vehicle or other) from its estimated size and motion (track_manager.h describes both).
 #pragma once
 
+#include <limits>
 #include <optional>
 
 #include "tracker/core/ekf.h"
@@ -34,6 +35,6 @@ class MoverTest {
 // any plausible size, or a vehicle detector's box measured it; otherwise other. Small objects
 // are other.
 ObjectClass Classify(const TrackManagerParams& params, const Track& t, bool vehicle_needs_box = false,
-                     std::int64_t utime = 0);
+                     std::int64_t utime = 0, double vehicle_box_score = -std::numeric_limits<double>::infinity());
 
 }  // namespace vtrack

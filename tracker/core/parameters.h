@@ -541,7 +541,7 @@ struct DetectionParams {
     using namespace param;
     v("mode", &mode, {"-", {}, "what measures tracks: scans (fitted outlines), boxes (a detector's), or both (fused)"});
     v("min_score", &min_score, {"-", Finite(), "boxes below this score, on the detector's own scale, are not used"});
-    v("birth_score", &birth_score, {"-", Finite(), "a box starts a track only from this score on"});
+    v("birth_score", &birth_score, {"-", Finite(), "a box starts a track only from this score on, and a track is a vehicle from this mean box score on (weaker ones are tracked, scored and exported as other)"});
     v("position_std", &position_std, {"m", OpenClosed(0, 10), "1-sigma of a box centre along each axis"});
     v("heading_std_deg", &heading_std_deg, {"deg", OpenClosed(0, 90), "1-sigma of a box heading (modulo 180 deg)"});
     v("gate_m", &gate_m, {"m", Above(0), "a box farther than this (+ gate_sigma predicted position stds) from a track is not its candidate"});

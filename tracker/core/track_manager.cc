@@ -454,7 +454,7 @@ void TrackManager::Report(std::int64_t utime, std::vector<TrackReport>* out) con
       r.z = t.box_z;
       r.height = t.box_height;
     }
-    r.object_class = Classify(params_, t, vehicle_needs_box_, utime);
+    r.object_class = Classify(params_, t, vehicle_needs_box_, utime, vehicle_box_score_);
     if (r.object_class != ObjectClass::kVehicle && sel.length_est && sel.width_est) {
       // Clutter: its own size, not the vehicle default.
       r.length = *sel.length_est;

@@ -73,6 +73,7 @@
 #include <array>
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -123,9 +124,13 @@ class TrackManager {
   // The id of the next track (>= 1; ids then count up from it). A process that restarts gives
   // a larger one than any id it gave before (the live tracker: from the wall clock).
   void SetNextId(std::int64_t id) { next_id_ = id; }
-  // Fused input: the detector is the vehicle evidence, so a track no box has updated is
-  // reported as other, whatever its size (see DetectionParams::fused_vehicle_needs_box).
-  void SetVehicleNeedsBox(bool needs_box) { vehicle_needs_box_ = needs_box; }
+  // How tracks measured by a detector's boxes are classed (classification.h, Classify): a
+  // vehicle from a mean box score of vehicle_box_score on; with needs_box (fused input) a track no
+  // box has updated lately is other, whatever its size.
+  void SetBoxClassRule(bool needs_box, double vehicle_box_score) {
+    vehicle_needs_box_ = needs_box;
+    vehicle_box_score_ = vehicle_box_score;
+  }
   const std::vector<Track>& tracks() const { return tracks_; }
   const TrackManagerParams& params() const { return params_; }
 
@@ -174,6 +179,7 @@ class TrackManager {
   std::vector<Track> tracks_;
   std::int64_t next_id_ = 1;
   bool vehicle_needs_box_ = false;
+  double vehicle_box_score_ = -std::numeric_limits<double>::infinity();  // [-] detector's scale
 };
 
 }  // namespace vtrack

@@ -51,8 +51,9 @@ Tracker::Tracker(const TrackerParams& params, bool debug)
   if (!params_.Validate(&error)) throw std::invalid_argument(error);
   ekf_ = std::make_unique<Ekf>(params_.ism, params_.vasm, params_.ekf, params_.cv);
   manager_ = std::make_unique<TrackManager>(params_.manager, *ekf_, params_.fit, params_.shape);
-  manager_->SetVehicleNeedsBox(params_.detections.mode == InputMode::kFused &&
-                               params_.detections.fused_vehicle_needs_box);
+  manager_->SetBoxClassRule(params_.detections.mode == InputMode::kFused &&
+                                params_.detections.fused_vehicle_needs_box,
+                            params_.detections.birth_score);
 }
 
 std::int64_t FirstTrackIdAt(std::int64_t wall_utime) {

@@ -15,6 +15,7 @@
 #include "vtrack/detection_list_t.hpp"
 #include "vtrack/detection_t.hpp"
 #include "vtrack/ladar_scan_t.hpp"
+#include "vtrack/ladar_slice_t.hpp"
 #include "vtrack/object_list_t.hpp"
 #include "vtrack/pose_t.hpp"
 #include "vtrack/track_debug_t.hpp"

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "lcmtypes/util/ladar_slices.h"
 #include "tests/fuzz/tracker_program.h"
 #include "tests/lcmtypes/random_messages.h"
 
@@ -102,6 +103,7 @@ int main(int argc, char** argv) {
     Write(out / "tracker_status_t", n, r.Status());
     Write(out / "detection_list_t", n, r.DetectionList(i * 3));
     Write(out / "detection_t", n, r.Detection());
+    Write(out / "ladar_slice_t", n, vtrack::lcm_util::SliceSweep(r.Scan(8 + i * 7), 2)[0]);
   }
   WriteLogSeeds(out / "log_reader", &r);
   WriteBytes(out / "tracker", "mht_plane", TrackerProgram(0, 1, 0));

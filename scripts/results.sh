@@ -114,8 +114,8 @@ kitti_dir=$data/kitti_tracking_0000
 boxes_dir=$data/kitti_tracking_boxes
 what=$scenarios
 if [ "$use_kitti" = 1 ] && [ -d "$kitti_dir" ]; then
-  compare_args+=(--kitti "$(rel "$kitti_dir")" --kitti-input-modes scans,fused)
-  what+=",KITTI 0000 (scans; scans and detector boxes fused)"
+  compare_args+=(--kitti "$(rel "$kitti_dir")" --kitti-input-modes scans,boxes,fused)
+  what+=",KITTI 0000 (scans; detector boxes; both fused)"
 elif [ "$use_kitti" = 1 ]; then
   say "no $kitti_dir: KITTI 0000 is left out"
 fi

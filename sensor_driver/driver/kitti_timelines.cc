@@ -27,10 +27,12 @@ KittiTimeline::KittiTimeline(kitti::SequenceOptions options, lcm::LCM* lcm)
 std::int64_t KittiTimeline::LapUs() const { return seq_->num_frames() * kFrameUs; }
 
 KittiScanTimeline::KittiScanTimeline(kitti::SequenceOptions options, lcm::LCM* lcm,
-                                     SweepOutput output, std::string truth_channel)
+                                     SweepOutput output, std::string truth_channel,
+                                     std::string detections_channel)
     : KittiTimeline(std::move(options), lcm),
       output_(std::move(output)),
-      truth_channel_(std::move(truth_channel)) {}
+      truth_channel_(std::move(truth_channel)),
+      detections_channel_(std::move(detections_channel)) {}
 
 std::int64_t KittiScanTimeline::PublishOffsetUs(int i) const {
   return seq().ScanUtime(i) - base() + seq().options().velodyne.sweep_duration_us;
@@ -48,6 +50,12 @@ void KittiScanTimeline::Prepare(int i, std::int64_t lap_start_utime, std::int64_
     truth_.utime += shift;
     truth_.scan_seq = scan_.seq;
   }
+  have_detections_ = !detections_channel_.empty() && seq().has_detections();
+  if (have_detections_) {
+    detections_ = seq().Detections(i);
+    detections_.utime += shift;
+    detections_.seq = scan_.seq;
+  }
 }
 
 void KittiScanTimeline::Publish() {
@@ -56,6 +64,9 @@ void KittiScanTimeline::Publish() {
   }, /*paced=*/true);
   if (have_truth_ && lcm()->publish(truth_channel_, &truth_) < 0) {
     log_.Warn("publish_truth", "publishing " + truth_channel_ + " failed");
+  }
+  if (have_detections_ && lcm()->publish(detections_channel_, &detections_) < 0) {
+    log_.Warn("publish_detections", "publishing " + detections_channel_ + " failed");
   }
 }
 

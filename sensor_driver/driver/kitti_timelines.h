@@ -44,8 +44,11 @@ class KittiTimeline : public Timeline {
 class KittiScanTimeline : public KittiTimeline {
  public:
   // Throws kitti::KittiError for a missing or malformed sequence.
+  // detections_channel: the detector's boxes of the frame (detections/pointrcnn_Car), published
+  // right after its sweep as vtrack-kitti2lcm writes them; "" or a sequence without them = none.
   KittiScanTimeline(kitti::SequenceOptions options, lcm::LCM* lcm, SweepOutput output,
-                    std::string truth_channel /* "" = no ground truth */);
+                    std::string truth_channel /* "" = no ground truth */,
+                    std::string detections_channel = "");
   int Count() const override { return seq().num_frames(); }
   std::int64_t PublishOffsetUs(int i) const override;
   void Prepare(int i, std::int64_t lap_start_utime, std::int64_t lap) override;
@@ -54,9 +57,12 @@ class KittiScanTimeline : public KittiTimeline {
  private:
   SweepOutput output_;
   std::string truth_channel_;
+  std::string detections_channel_;
   vtrack::ladar_scan_t scan_;
   vtrack::object_list_t truth_;
+  vtrack::detection_list_t detections_;
   bool have_truth_ = false;
+  bool have_detections_ = false;
   lcm_util::RateLimitedLog log_{"vtrack-ladar-driver"};
 };
 

@@ -24,10 +24,14 @@ int main(int argc, char** argv) {
   vtrack::sim::AddSweepOutputOptions(&desc, /*live=*/true);
   desc.add_options()
       ("truth-channel", po::value<std::string>()->default_value("GROUND_TRUTH"), "channel of the ground truth")
-      ("no-truth", "do not publish ground truth");
+      ("no-truth", "do not publish ground truth")
+      ("detections-channel", po::value<std::string>()->default_value("DETECTIONS"),
+       "--kitti: channel of the detector's boxes (detections/pointrcnn_Car, where the folder has them)")
+      ("no-detections", "--kitti: do not publish the detector's boxes");
   vtrack::sim::AddLiveRunOptions(&desc);
   const std::string usage =
-      "vtrack-ladar-driver: publish LADAR scans and ground truth live, from a scenario or KITTI.\n\n"
+      "vtrack-ladar-driver: publish LADAR scans and ground truth live, from a scenario or KITTI\n"
+      "(and, for KITTI, the detector's boxes on DETECTIONS).\n\n"
       "usage: vtrack-ladar-driver --scenario NAME [--sensor S] [--seed N] [--start-utime U]\n"
       "       vtrack-ladar-driver --kitti DIR [--sequence N] [--poses F | --oxts F]\n"
       "Run vtrack-ego-pose with the same scenario/KITTI options and --start-utime (or none) for\n"
@@ -50,8 +54,10 @@ int main(int argc, char** argv) {
   vtrack::sim::LiveSource source;
 #ifdef VTRACK_HAVE_KITTI
   source.kitti = [&](lcm::LCM* lcm) {
+    const std::string detections_channel =
+        vm.count("no-detections") ? "" : vm["detections-channel"].as<std::string>();
     auto t = std::make_unique<vtrack::sim::KittiScanTimeline>(
-        vtrack::sim::KittiCliOptions(vm), lcm, output, truth_channel);
+        vtrack::sim::KittiCliOptions(vm), lcm, output, truth_channel, detections_channel);
     std::fprintf(stderr, "vtrack-ladar-driver: KITTI sequence %s, %d frames\n",
                  vm["sequence"].as<std::string>().c_str(), t->Count());
     return t;

@@ -28,12 +28,9 @@ Vector6d CvModel::Propagate(const Vector6d& x, double dt, Matrix6d* D_next_x) co
 }
 
 Matrix6d CvModel::ProcessNoise(const Vector6d& /*x*/, double dt) const {
-  const double dt2 = dt * dt;
-  Eigen::Matrix2d q1;
-  q1 << dt2 * dt / 3.0, dt2 / 2.0, dt2 / 2.0, dt;
   Matrix6d Q = Matrix6d::Zero();
-  Q.block<2, 2>(0, 0) = params_.alpha * q1;
-  Q.block<2, 2>(2, 2) = params_.alpha * q1;
+  Q.block<2, 2>(0, 0) = WhiteAccelerationNoise(params_.alpha, dt);
+  Q.block<2, 2>(2, 2) = WhiteAccelerationNoise(params_.alpha, dt);
   Q(4, 4) = params_.q_theta * dt;
   return Q;
 }

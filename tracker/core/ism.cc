@@ -29,13 +29,10 @@ Vector6d IsmModel::Propagate(const Vector6d& x, double dt, Matrix6d* D_next_x) c
 
 Matrix6d IsmModel::ProcessNoise(const Vector6d& /*x*/, double dt) const {
   // Eq. (3) per axis, Eq. (4) block diagonal.
-  const double dt2 = dt * dt;
-  Eigen::Matrix2d q1;
-  q1 << dt2 * dt / 3.0, dt2 / 2.0, dt2 / 2.0, dt;
   Matrix6d Q = Matrix6d::Zero();
-  Q.block<2, 2>(0, 0) = params_.alpha * q1;
-  Q.block<2, 2>(2, 2) = params_.alpha * q1;
-  Q.block<2, 2>(4, 4) = params_.beta * q1;
+  Q.block<2, 2>(0, 0) = WhiteAccelerationNoise(params_.alpha, dt);
+  Q.block<2, 2>(2, 2) = WhiteAccelerationNoise(params_.alpha, dt);
+  Q.block<2, 2>(4, 4) = WhiteAccelerationNoise(params_.beta, dt);
   return Q;
 }
 

@@ -34,6 +34,16 @@ enum class ModelKind : int { kIsm = 0, kVasm = 1, kCv = 2 };  // same values as 
 // the ISM and the constant-velocity model (cv.h, theta_dot held at 0).
 inline bool HasIsmLayout(ModelKind kind) { return kind != ModelKind::kVasm; }
 
+// The covariance over dt of one axis (position, rate) driven by white acceleration of spectral
+// density q (paper Eq. 2-3): q [dt^3/3 dt^2/2; dt^2/2 dt]. Shared by the ISM (x, y, theta) and
+// the constant-velocity model (x, y).
+inline Eigen::Matrix2d WhiteAccelerationNoise(double q, double dt) {
+  const double dt2 = dt * dt;
+  Eigen::Matrix2d Q;
+  Q << dt2 * dt / 3.0, dt2 / 2.0, dt2 / 2.0, dt;
+  return q * Q;
+}
+
 }  // namespace vtrack
 
 template <>

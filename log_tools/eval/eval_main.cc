@@ -20,7 +20,7 @@ using namespace vtrack::eval;
 
 int main(int argc, char** argv) {
   std::vector<std::string> logs;
-  std::string json_path, csv_path, plots_dir, kitti_out;
+  std::string json_path, csv_path, plots_dir, kitti_out, labels_path;
   bool quiet = false;
   EvalCliOptions eval_opts;
 
@@ -33,6 +33,9 @@ int main(int argc, char** argv) {
     ("json", po::value(&json_path), "write the JSON summary here")
     ("csv", po::value(&csv_path), "write the per-track CSV here")
     ("plots", po::value(&plots_dir), "write PNG plots into this directory")
+    ("track-labels", po::value(&labels_path),
+     "write every track of every scored frame (any status, any class) with its label against "
+     "the truth here (CSV: 1 vehicle, 0 not a vehicle, -1 ignore)")
     ("kitti-out", po::value(&kitti_out), "export tracks in the KITTI tracking result format "
                                          "(needs --kitti-calib)")
     ("quiet,q", po::bool_switch(&quiet), "no progress output");
@@ -77,7 +80,8 @@ int main(int argc, char** argv) {
       }
     });
     progress.Finish();
-    const EvalSummary summary = Evaluate(data, params);
+    std::vector<TrackLabel> labels;
+    const EvalSummary summary = Evaluate(data, params, labels_path.empty() ? nullptr : &labels);
     std::cout << SummaryText(summary);
     if (!json_path.empty()) {
       WriteTextFile(json_path, SummaryJson(summary));
@@ -86,6 +90,10 @@ int main(int argc, char** argv) {
     if (!csv_path.empty()) {
       WriteTextFile(csv_path, TrackCsv(summary));
       std::cout << "wrote " << csv_path << "\n";
+    }
+    if (!labels_path.empty()) {
+      WriteTextFile(labels_path, TrackLabelCsv(labels));
+      std::cout << "wrote " << labels_path << "\n";
     }
     if (!plots_dir.empty()) {
       for (const auto& p : WriteEvalPlots(summary, plots_dir)) std::cout << "wrote " << p << "\n";

@@ -346,10 +346,12 @@ std::string SelectMode(const LogData& data, const EvalParams& params) {
   return data.tracks.begin()->first;
 }
 
-EvalSummary Evaluate(const LogData& data, const EvalParams& params) {
+EvalSummary Evaluate(const LogData& data, const EvalParams& params,
+                     std::vector<TrackLabel>* labels) {
   if (const std::string err = params.Validate(); !err.empty()) {
     throw std::runtime_error("invalid evaluation parameter: " + err);
   }
+  if (labels) labels->clear();
   EvalSummary s;
   s.params = params;
   s.logs = data.paths;
@@ -441,6 +443,53 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params) {
         scored.push_back(&o);
         f.gt_ids.push_back(o.id);
         f.gt_xy.emplace_back(o.x, o.y);
+      }
+    }
+
+    if (labels) {
+      // Every track of the frame, whatever its status and class, against the nearest truth
+      // object of any class. Refused tracks are counted apart: the summary's problems stay those
+      // of the scoring.
+      std::optional<Eigen::Isometry3d> range_pose = ego;
+      if (!range_pose && !data.poses.empty()) range_pose = data.poses.At(utime, max_pose_gap_us);
+      std::set<std::int64_t> label_ids;
+      std::map<std::string, std::int64_t> label_problems;
+      for (const auto& tr : list.tracks) {
+        if (!Admit(tr.x, tr.y, tr.theta, tr.id, "track", &label_ids, &label_problems)) continue;
+        const TrackPose tp = Advance(tr, dt);
+        TrackLabel row;
+        row.utime = utime;
+        row.track_id = tr.id;
+        row.range_m = range_pose ? (Eigen::Vector2d(tp.x, tp.y) -
+                                    range_pose->translation().head<2>()).norm()
+                                 : kNaN;
+        int nearest = -1;
+        row.distance_m = kNaN;
+        for (std::size_t i = 0; i < all_truth.size(); ++i) {
+          const double d = std::hypot(tp.x - all_truth[i]->x, tp.y - all_truth[i]->y);
+          if (nearest < 0 || d < row.distance_m) {
+            nearest = static_cast<int>(i);
+            row.distance_m = d;
+          }
+        }
+        const bool gated = nearest >= 0 && row.distance_m < params.gate_m;
+        if (gated) {
+          row.truth_id = all_truth[nearest]->id;
+          row.truth_class = all_truth[nearest]->object_class;
+        }
+        if (!in_region(tp.x, tp.y, std::nullopt)) {
+          row.label = -1;
+        } else if (!gated) {
+          row.label = 0;
+        } else if (truth_scored[nearest]) {
+          row.label = 1;
+        } else if (IsVehicleClass(all_truth[nearest]->object_class) ||
+                   all_truth[nearest]->object_class == vtrack::object_t::CLASS_UNKNOWN) {
+          row.label = -1;
+        } else {
+          row.label = 0;
+        }
+        labels->push_back(row);
       }
     }
 

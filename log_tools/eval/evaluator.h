@@ -192,13 +192,35 @@ struct EvalSummary {
   double truth_time_offset_s = 0.0;       // [s] the offset applied (see EvalParams)
 };
 
+// One (frame, track) row of the labelled set vtrack-eval --track-labels writes: for every track
+// (any status, any class) of every scored frame, whether it lies on a vehicle, judged against the
+// ground truth with the scoring's own rules (truth time offset, region, gate).
+struct TrackLabel {
+  std::int64_t utime = 0;     // [us] the track list's utime
+  std::int64_t track_id = 0;
+  // 1: the nearest truth object within gate_m is a scored vehicle (vehicle class, labelled, in
+  // the region); 0: it is of another class (wall, pole, pedestrian, ...) or no truth object is
+  // within gate_m; -1 (ignore): the track centre is outside the scoring region, or the nearest
+  // truth within gate_m is an unscored vehicle (outside the labelled region or the scoring
+  // region) or of CLASS_UNKNOWN (KITTI DontCare).
+  int label = 0;
+  double range_m = 0.0;       // [m] track centre from the ego position; NaN without an ego pose
+  std::int64_t truth_id = -1;      // nearest truth object within gate_m; -1 if none
+  int truth_class = -1;            // its object_t.object_class; -1 if none
+  double distance_m = 0.0;    // [m] centre distance to the nearest truth object (any distance);
+                              //     NaN if the frame holds none
+};
+
 // The 95 % quantile of chi-square with 3 degrees of freedom.
 inline constexpr double kChi2Dof3Quantile95 = 7.814727903251178;
 
 // Scores the logs' tracks of params.mode. Throws std::runtime_error with a clear message if the
 // logs hold no ground truth, no tracks, tracks of several modes with no mode chosen, or no pose
 // while a scoring region is requested.
-EvalSummary Evaluate(const LogData& data, const EvalParams& params);
+// If labels is given, it receives one TrackLabel per admitted track (finite position and
+// heading, first of its id) of every scored frame, in time order; the summary is the same.
+EvalSummary Evaluate(const LogData& data, const EvalParams& params,
+                     std::vector<TrackLabel>* labels = nullptr);
 
 // The mode that Evaluate scores for these params (throws as Evaluate does).
 std::string SelectMode(const LogData& data, const EvalParams& params);

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iomanip>
 #include <limits>
 #include <set>
 #include <sstream>
@@ -303,6 +304,21 @@ std::string TrackCsv(const EvalSummary& s) {
        << Csv(r.yaw_rate_rmse_dps) << ',' << Csv(r.rear_axle_rmse_m) << ',' << Csv(r.nees_mean);
     for (const double e : r.prediction_error_m) os << ',' << Csv(e);
     os << "\n";
+  }
+  return os.str();
+}
+
+std::string TrackLabelCsv(const std::vector<TrackLabel>& labels) {
+  std::ostringstream os;
+  os << std::setprecision(12);
+  const auto number = [&os](double v) -> std::ostream& {
+    return std::isnan(v) ? os << "nan" : os << v;  // one spelling for every NaN ("-nan" too)
+  };
+  os << "utime,track_id,label,range_m,truth_id,truth_class,distance_m\n";
+  for (const TrackLabel& r : labels) {
+    os << r.utime << ',' << r.track_id << ',' << r.label << ',';
+    number(r.range_m) << ',' << r.truth_id << ',' << r.truth_class << ',';
+    number(r.distance_m) << '\n';
   }
   return os.str();
 }

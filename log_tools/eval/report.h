@@ -17,6 +17,11 @@ void WriteTextFile(const std::string& path, const std::string& text);
 // One row per scored track: its span, matches, dominant truth object and errors.
 std::string TrackCsv(const EvalSummary& s);
 
+// The labelled set of Evaluate's labels: header
+// utime,track_id,label,range_m,truth_id,truth_class,distance_m, one row per TrackLabel; NaN
+// prints as "nan".
+std::string TrackLabelCsv(const std::vector<TrackLabel>& labels);
+
 // Writes errors_over_time.png, detections_over_time.png and prediction_error.png into dir
 // (created if missing). Returns the paths written.
 std::vector<std::string> WriteEvalPlots(const EvalSummary& s, const std::string& dir);

@@ -91,6 +91,49 @@ TEST_F(EvalCliTest, WritesJsonCsvAndPlots) {
   }
 }
 
+TEST_F(EvalCliTest, TrackLabelsFileLeavesTheScoresAlone) {
+  const std::string plain = dir_ + "/plain.json", json = dir_ + "/l.json", labels = dir_ + "/l.csv";
+  std::string out;
+  ASSERT_EQ(RunTool({run_, tracks_, "-q", "--json", plain}, &out), 0) << out;
+  ASSERT_EQ(RunTool({run_, tracks_, "-q", "--json", json, "--track-labels", labels}, &out), 0) << out;
+  EXPECT_NE(out.find("wrote " + labels), std::string::npos) << out;
+  auto slurp = [](const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  EXPECT_EQ(slurp(plain), slurp(json));
+  // Every track (1..7, any status and class) of each of the kScans frames with truth (the track
+  // list at +100 s has none): labels by synthetic_run.h.
+  std::ifstream in(labels);
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(line, "utime,track_id,label,range_m,truth_id,truth_class,distance_m");
+  int rows = 0;
+  std::int64_t last_utime = 0;
+  while (std::getline(in, line)) {
+    ++rows;
+    std::vector<std::string> f;
+    std::istringstream fields(line);
+    for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
+    ASSERT_EQ(f.size(), 7u) << line;
+    const std::int64_t utime = std::stoll(f[0]);
+    EXPECT_GE(utime, last_utime);
+    EXPECT_LT(utime, kUtime0 + kScans * 100'000);
+    last_utime = utime;
+    const int id = std::stoi(f[1]);
+    const std::string label_truth = f[2] + "," + f[4] + "," + f[5];
+    if (id == 1 || id == 2) EXPECT_EQ(label_truth, "1," + f[1] + ",1") << line;  // cars A, B
+    if (id == 3) EXPECT_EQ(label_truth, "0,-1,-1") << line;       // other, far from everything
+    if (id == 4) EXPECT_EQ(label_truth, "0,3,5") << line;         // on the pedestrian
+    if (id == 5) EXPECT_EQ(label_truth, "-1,4,1") << line;        // on the unlabelled car
+    if (id == 2) EXPECT_NEAR(std::stod(f[6]), 0.0, 1e-9) << line;
+    if (id == 3) EXPECT_NEAR(std::stod(f[3]), std::hypot(50.0, 50.0), 1e-6) << line;  // ego at 0
+  }
+  EXPECT_EQ(rows, 7 * kScans);
+}
+
 TEST_F(EvalCliTest, KittiExportFollowsTheCalibration) {
   // A calibration with P2 = [500 0 600 0; 0 500 180 0; 0 0 1 0], R0_rect = I and
   // Tr_velo_to_cam the axis permutation (velo x forward, y left, z up -> cam x right, y down,

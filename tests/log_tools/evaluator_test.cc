@@ -4,7 +4,9 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numbers>
+#include <sstream>
 
 #include "lcmtypes/util/log_reader.h"
 #include "log_tools/eval/evaluator.h"
@@ -13,6 +15,7 @@
 #include "vtrack/object_list_t.hpp"
 #include "vtrack/track_list_t.hpp"
 #include "vtrack/ladar_scan_t.hpp"
+#include "vtrack/pose_t.hpp"
 #include "tests/log_tools/synthetic_run.h"
 #include "tests/support/test_env.h"
 
@@ -300,6 +303,205 @@ TEST_F(EvaluatorTest, TruthTimeOffset) {
   EXPECT_LT(shifted.position_rmse_m, 0.003);
   EXPECT_GT(plain.prediction_error_m[0], 0.2);
   EXPECT_LT(shifted.prediction_error_m[0], 0.01);
+}
+
+// vtrack-eval --track-labels: every track of every scored frame, any status and class, labelled
+// against the nearest truth object of any class. Ego at the origin heading +x; truth in both
+// frames: car 10 in the labelled region at (10, 0), wall 11 at (0, 10), car 12 outside the
+// labelled region at (-10, 0), DontCare 13 (CLASS_UNKNOWN) at (0, -10).
+class TrackLabelsTest : public ::testing::Test {
+ protected:
+  static constexpr std::int64_t kT0 = 1'700'000'000'000'000;
+  static constexpr std::int64_t kDt = 100'000;
+  struct Expect {
+    std::int64_t track_id;
+    double x, y;
+    int label;
+    std::int64_t truth_id;
+    int truth_class;
+    double distance_m;
+  };
+  void SetUp() override {
+    dir_ = vtrack::testing::ScratchDir("track_labels");
+    run_ = dir_ + "/run.lcm";
+    tracks_ = dir_ + "/tracks.lcm";
+    poses_ = dir_ + "/poses.lcm";
+    lcm_util::LogWriter run(run_);
+    // Truth at frames 0 and 1, and at frame 3 (no track list there).
+    for (const int k : {0, 1, 3}) {
+      vtrack::object_list_t gt{};
+      gt.utime = kT0 + k * kDt;
+      auto add = [&](std::int64_t id, std::int8_t cls, double x, double y, bool labelled) {
+        vtrack::object_t o{};
+        o.id = id;
+        o.object_class = cls;
+        o.x = x;
+        o.y = y;
+        o.length = 4.0;
+        o.width = 1.8;
+        o.height = 1.5;
+        o.rear_axle_offset = std::numeric_limits<double>::quiet_NaN();
+        o.in_labelled_region = labelled;
+        o.num_points = -1;
+        gt.objects.push_back(o);
+      };
+      add(10, vtrack::object_t::CLASS_CAR, 10.0, 0.0, true);
+      add(11, vtrack::object_t::CLASS_WALL, 0.0, 10.0, true);
+      add(12, vtrack::object_t::CLASS_CAR, -10.0, 0.0, false);
+      add(13, vtrack::object_t::CLASS_UNKNOWN, 0.0, -10.0, true);
+      gt.num_objects = static_cast<std::int32_t>(gt.objects.size());
+      run.WriteMessage(gt.utime, "GROUND_TRUTH", gt);
+    }
+    lcm_util::LogWriter poses(poses_);
+    for (int k = 0; k <= 3; ++k) {
+      vtrack::pose_t p{};
+      p.utime = kT0 + k * kDt;
+      p.orientation[0] = 1.0;
+      poses.WriteMessage(p.utime, "EGO_POSE", p);
+    }
+    // Track lists at frames 0, 1 and 2 (no truth at frame 2).
+    lcm_util::LogWriter tracks(tracks_);
+    for (const int k : {0, 1, 2}) {
+      vtrack::track_list_t l{};
+      l.utime = kT0 + k * kDt;
+      l.mode = "mht";
+      auto add = [&](std::int64_t id, std::int8_t status, std::int8_t cls, double x, double y) {
+        vtrack::track_t t{};
+        t.id = id;
+        t.status = status;
+        t.object_class = cls;
+        t.x = x;
+        t.y = y;
+        t.length = 4.0;
+        t.width = 1.8;
+        t.rear_axle_offset = std::numeric_limits<double>::quiet_NaN();
+        for (int i = 0; i < 9; i += 4) t.cov[i] = 0.01;
+        l.tracks.push_back(t);
+      };
+      const auto confirmed = vtrack::track_t::STATUS_CONFIRMED;
+      const auto vehicle = vtrack::track_t::CLASS_VEHICLE;
+      for (const Expect& e : Expected()) {
+        const bool tentative_other = e.track_id == 5;
+        add(e.track_id, tentative_other ? vtrack::track_t::STATUS_TENTATIVE
+                        : e.track_id == 6 ? vtrack::track_t::STATUS_COASTING : confirmed,
+            tentative_other ? vtrack::track_t::CLASS_OTHER : vehicle, e.x, e.y);
+      }
+      add(7, confirmed, vehicle, std::numeric_limits<double>::quiet_NaN(), 0.0);  // refused
+      l.num_tracks = static_cast<std::int32_t>(l.tracks.size());
+      tracks.WriteMessage(l.utime, "TRACKS", l);
+    }
+  }
+  // The tracks and what each must get, worked out by hand (gate 2 m).
+  static std::vector<Expect> Expected() {
+    const auto car = vtrack::object_t::CLASS_CAR;
+    return {
+        {1, 10.3, 0.4, 1, 10, car, 0.5},                     // on the labelled car
+        {2, 0.6, 10.8, 0, 11, vtrack::object_t::CLASS_WALL, 1.0},  // on the wall
+        {3, 25.0, 30.0, 0, -1, -1, std::sqrt(25.0 * 25.0 + 20.0 * 20.0)},  // nearest: wall
+        {4, -10.0, 1.2, -1, 12, car, 1.2},                   // on the unlabelled car
+        {5, 9.7, -0.4, 1, 10, car, 0.5},                     // tentative, class other
+        {6, 0.9, -10.0, -1, 13, vtrack::object_t::CLASS_UNKNOWN, 0.9},  // coasting, DontCare
+    };
+  }
+  // Checks rows against Expected() for frames 0 and 1, with label overridden by labels (if given).
+  static void CheckRows(const std::vector<TrackLabel>& rows, bool with_range,
+                        const std::map<std::int64_t, int>& label_override = {}) {
+    const auto expected = Expected();
+    ASSERT_EQ(rows.size(), 2 * expected.size());
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      const Expect& e = expected[r % expected.size()];
+      const TrackLabel& row = rows[r];
+      SCOPED_TRACE("row " + std::to_string(r) + ", track " + std::to_string(e.track_id));
+      EXPECT_EQ(row.utime, kT0 + static_cast<std::int64_t>(r / expected.size()) * kDt);
+      EXPECT_EQ(row.track_id, e.track_id);
+      const auto o = label_override.find(e.track_id);
+      EXPECT_EQ(row.label, o == label_override.end() ? e.label : o->second);
+      EXPECT_EQ(row.truth_id, e.truth_id);
+      EXPECT_EQ(row.truth_class, e.truth_class);
+      EXPECT_NEAR(row.distance_m, e.distance_m, 1e-9);
+      if (with_range) {
+        EXPECT_NEAR(row.range_m, std::hypot(e.x, e.y), 1e-9);
+      } else {
+        EXPECT_TRUE(std::isnan(row.range_m));
+      }
+    }
+  }
+  std::string dir_, run_, tracks_, poses_;
+};
+
+TEST_F(TrackLabelsTest, EveryTrackOfEveryScoredFrameIsLabelled) {
+  const EvalParams params;
+  // Without a pose in the logs, the range is unknown.
+  {
+    std::vector<TrackLabel> rows;
+    Evaluate(LoadLogs({run_, tracks_}, params), params, &rows);
+    CheckRows(rows, false);
+  }
+  const LogData data = LoadLogs({run_, tracks_, poses_}, params);
+  std::vector<TrackLabel> rows;
+  const EvalSummary with = Evaluate(data, params, &rows);
+  CheckRows(rows, true);
+  // The scores are those without labels.
+  const EvalSummary without = Evaluate(data, params);
+  EXPECT_EQ(SummaryJson(with), SummaryJson(without));
+  EXPECT_EQ(TrackCsv(with), TrackCsv(without));
+  EXPECT_EQ(SummaryText(with), SummaryText(without));
+  EXPECT_EQ(with.problems.count("track_not_finite"), 1u);
+  EXPECT_EQ(with.problems.at("track_not_finite"), 2);  // the scoring's own count, not doubled
+  // Scored: car 10 only; track 1 matches it, track 3 is a false positive, 2 (on the wall) and 4
+  // (on the unlabelled car) pair with ignored truth and are dropped, 5 and 6 are not scored
+  // (tentative other, coasting).
+  EXPECT_EQ(with.clear.true_positives, 2);
+  EXPECT_EQ(with.clear.false_positives, 2);
+  EXPECT_EQ(with.ignored_track_detections, 4);
+
+  // The file: the header, then one line per row with the values above (read back as numbers).
+  std::istringstream in(TrackLabelCsv(rows));
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(line, "utime,track_id,label,range_m,truth_id,truth_class,distance_m");
+  const auto expected = Expected();
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    ASSERT_TRUE(std::getline(in, line)) << r;
+    std::vector<std::string> f;
+    std::istringstream fields(line);
+    for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
+    ASSERT_EQ(f.size(), 7u) << line;
+    const Expect& e = expected[r % expected.size()];
+    EXPECT_EQ(f[0], std::to_string(kT0 + static_cast<std::int64_t>(r / expected.size()) * kDt));
+    EXPECT_EQ(f[1], std::to_string(e.track_id));
+    EXPECT_EQ(f[2], std::to_string(e.label));
+    EXPECT_NEAR(std::stod(f[3]), std::hypot(e.x, e.y), 1e-9) << line;
+    EXPECT_EQ(f[4], std::to_string(e.truth_id));
+    EXPECT_EQ(f[5], std::to_string(e.truth_class));
+    EXPECT_NEAR(std::stod(f[6]), e.distance_m, 1e-9) << line;
+  }
+  EXPECT_FALSE(std::getline(in, line)) << "extra line: " << line;
+  // Without a pose the range is written as nan.
+  std::vector<TrackLabel> no_pose;
+  Evaluate(LoadLogs({run_, tracks_}, params), params, &no_pose);
+  std::istringstream in2(TrackLabelCsv(no_pose));
+  std::getline(in2, line);
+  std::getline(in2, line);
+  EXPECT_EQ(line, std::to_string(kT0) + ",1,1,nan,10,1,0.5");
+}
+
+TEST_F(TrackLabelsTest, OutsideTheScoringRegionIsIgnored) {
+  EvalParams params;
+  params.region_range_m = 15.0;  // everything but track 3 at 39 m is inside
+  const LogData data = LoadLogs({run_, tracks_, poses_}, params);
+  std::vector<TrackLabel> rows;
+  const EvalSummary with = Evaluate(data, params, &rows);
+  CheckRows(rows, true, {{3, -1}});
+  EXPECT_EQ(SummaryJson(with), SummaryJson(Evaluate(data, params)));
+  // 9.9 m leaves car 10 (at 10 m) outside the region: track 5 at 9.71 m is inside, but the
+  // nearest truth is an unscored vehicle, so it is ignored; every other track is outside.
+  params.region_range_m = 9.9;
+  Evaluate(data, params, &rows);
+  CheckRows(rows, true, {{1, -1}, {2, -1}, {3, -1}, {4, -1}, {5, -1}, {6, -1}});
+  ASSERT_EQ(rows.size(), 12u);
+  EXPECT_EQ(rows[4].track_id, 5);
+  EXPECT_LT(rows[4].range_m, 9.9);
 }
 
 }  // namespace

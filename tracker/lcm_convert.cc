@@ -108,6 +108,7 @@ track_t TrackToLcm(const TrackReport& r) {
   t.age = r.age;
   t.num_updates = r.num_updates;
   t.score = static_cast<float>(r.score);
+  t.vehicle_probability = static_cast<float>(r.vehicle_probability);
   t.z = r.z;
   t.height = r.height;
   t.npred = static_cast<int32_t>(r.prediction.size());

@@ -196,6 +196,9 @@ int main(int argc, char** argv) {
       ("input", po::value(&input), "LCM log to track offline, as fast as possible")
       ("output", po::value(&output), "LCM log to write (with --input): TRACKS, TRACKER_STATUS, TRACK_DEBUG")
       ("debug", po::bool_switch(&options.debug), "also publish TRACK_DEBUG (large)")
+      ("evidence-csv", po::value(&options.evidence_csv),
+       "write every scan's vehicle-evidence features per track to this CSV (the fitting set of "
+       "scripts/fit-vehicle-evidence)")
       ("first-track-id", po::value(&first_track_id),
        "id of the first track (>= 1); default: live, from the start time (start ms x 100000 + 1,\n"
        "so that a restarted tracker never reuses an id), offline 1 (reruns identical)")

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <stdexcept>
 
 #include "lcmtypes/util/decode.h"
 #include "tracker/lcm_convert.h"
@@ -18,6 +19,28 @@ TrackerNode::TrackerNode(const TrackerParams& params, NodeOptions options, Publi
       publish_(std::move(publish)),
       tracker_(params, options_.debug) {
   tracker_.SetFirstTrackId(options_.first_track_id);
+  if (!options_.evidence_csv.empty()) {
+    evidence_csv_.open(options_.evidence_csv);
+    if (!evidence_csv_) {
+      throw std::invalid_argument("cannot write the evidence CSV '" + options_.evidence_csv + "'");
+    }
+    evidence_csv_.precision(7);
+    evidence_csv_ << "utime,track_id,three_d";
+    for (std::size_t k = 0; k < kNumEvidenceFeatures; ++k) {
+      evidence_csv_ << ',' << NameOf(static_cast<EvidenceFeature>(k));
+    }
+    evidence_csv_ << ",logit,log_odds\n";
+    tracker_.SetRecordEvidence(true);
+  }
+}
+
+void TrackerNode::WriteEvidence(const ScanOutput& o) {
+  for (const ScanOutput::EvidenceRow& r : o.evidence) {
+    evidence_csv_ << o.utime << ',' << r.track_id << ',' << (r.three_d ? 1 : 0);
+    for (const double f : r.features) evidence_csv_ << ',' << f;
+    evidence_csv_ << ',' << r.logit << ',' << r.log_odds << '\n';
+  }
+  if (!evidence_csv_) throw std::runtime_error("writing the evidence CSV '" + options_.evidence_csv + "' failed");
 }
 
 template <class Msg>
@@ -129,6 +152,7 @@ void TrackerNode::Emit(std::vector<ScanOutput>* outs) {
     msg.encode(buffer_.data(), 0, static_cast<int>(buffer_.size()));
     publish_(o.utime, options_.tracks_channel, buffer_.data(), buffer_.size());
     ++tracks_published_;
+    if (evidence_csv_.is_open()) WriteEvidence(o);
     if (options_.debug) {
       const track_debug_t dbg = DebugToLcm(o);
       buffer_.resize(static_cast<std::size_t>(dbg.getEncodedSize()));

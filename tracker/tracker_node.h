@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <string>
@@ -31,6 +32,10 @@ struct NodeOptions {
   std::string debug_channel = "TRACK_DEBUG";
   std::string status_channel = "TRACKER_STATUS";
   bool debug = false;  // publish TRACK_DEBUG
+  // If not empty: every scan's vehicle-evidence features of every track it gave returns, as CSV
+  // (utime, track_id, three_d, the features by name, logit, log_odds): the fitting set of
+  // scripts/fit-vehicle-evidence.
+  std::string evidence_csv;
   // The first track id. Offline: 1 (reruns identical). Live: FirstTrackIdAt(wall clock), so
   // that a restarted tracker never reuses an id that meant another vehicle before.
   std::int64_t first_track_id = 1;
@@ -67,6 +72,7 @@ class TrackerNode {
   // The wall time a scan or detection list of this utime arrived (for the latency figures).
   void NoteArrival(std::int64_t utime);
   void Emit(std::vector<ScanOutput>* outs);
+  void WriteEvidence(const ScanOutput& o);
   // Hands the sweeps the assembler put together (sweeps_) to the tracker.
   void FeedSweeps();
   void Warn();
@@ -87,6 +93,7 @@ class TrackerNode {
   lcm_util::SweepAssembler assembler_;
   std::vector<lcm_util::AssembledSweep> sweeps_;
   std::vector<std::uint8_t> buffer_;
+  std::ofstream evidence_csv_;
   std::int64_t last_tentative_ = 0, last_confirmed_ = 0, last_coasting_ = 0;
 };
 

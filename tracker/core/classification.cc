@@ -1,5 +1,7 @@
 #include "tracker/core/classification.h"
 
+#include "tracker/core/vehicle_evidence.h"
+
 #include <Eigen/Cholesky>
 
 #include <algorithm>
@@ -30,9 +32,9 @@ std::optional<bool> MoverTest::Evidence(const Ekf& ekf, const Track& t, bool pos
   return false;
 }
 
-ObjectClass Classify(const TrackManagerParams& params, const Track& t, bool vehicle_needs_box,
-                     std::int64_t utime, double vehicle_box_score) {
-  if (t.small_object) return ObjectClass::kOther;
+ObjectClass Classify(const TrackManagerParams& params, const EvidenceParams& evidence,
+                     const Track& t, bool vehicle_needs_box, std::int64_t utime,
+                     double vehicle_box_score) {
   // A track a detector's box measured is a vehicle if its boxes are, on average, as confident as
   // one that may start a track (vehicle_box_score = detections.birth_score); weaker ones stay
   // tracked, scored and exported (the KITTI criterion sweeps the score itself).
@@ -45,6 +47,12 @@ ObjectClass Classify(const TrackManagerParams& params, const Track& t, bool vehi
     return box_track && confident ? ObjectClass::kVehicle : ObjectClass::kOther;
   }
   if (t.box_updates > 0) return confident ? ObjectClass::kVehicle : ObjectClass::kOther;
+  if ((t.evidence_3d ? evidence.classifier_3d : evidence.classifier_2d) == VehicleClassifier::kEvidence) {
+    return VehicleProbability(t.vehicle_log_odds) >= evidence.vehicle_probability
+               ? ObjectClass::kVehicle
+               : ObjectClass::kOther;
+  }
+  if (t.small_object) return ObjectClass::kOther;
   const TrackHypothesis& sel = t.hyps[static_cast<std::size_t>(t.selected)];
   const double est_l = sel.length_est.value_or(0.0), est_w = sel.width_est.value_or(0.0);
   const bool vehicle_size = est_l <= params.vehicle_max_length &&

@@ -30,11 +30,15 @@ class MoverTest {
   double min_speed_ = 0.0;    // [m/s]
 };
 
-// The class of t: a vehicle if its estimated size (not the default lower bound) fits a vehicle,
-// or a face of a car's front or rear width was seen whole and the rest fits, or it is a mover of
-// any plausible size, or a vehicle detector's box measured it; otherwise other. Small objects
+// The class of t. A track a detector's box measured: from its boxes (below). Otherwise, with
+// evidence.classifier_3d (classifier_2d for tracks seen by single-plane scans) = evidence: a
+// vehicle from an accumulated vehicle probability of
+// evidence.vehicle_probability on (vehicle_evidence.h). With the rules: a vehicle if its
+// estimated size (not the default lower bound) fits a vehicle, or a face of a car's front or rear
+// width was seen whole and the rest fits, or it is a mover of any plausible size; small objects
 // are other.
-ObjectClass Classify(const TrackManagerParams& params, const Track& t, bool vehicle_needs_box = false,
-                     std::int64_t utime = 0, double vehicle_box_score = -std::numeric_limits<double>::infinity());
+ObjectClass Classify(const TrackManagerParams& params, const EvidenceParams& evidence,
+                     const Track& t, bool vehicle_needs_box = false, std::int64_t utime = 0,
+                     double vehicle_box_score = -std::numeric_limits<double>::infinity());
 
 }  // namespace vtrack

@@ -555,6 +555,102 @@ struct DetectionParams {
   bool Validate(std::string* error) const { return param::Validate(*this, error); }
 };
 
+// The vehicle evidence of a track (vehicle_evidence.h): per scan a logistic model of what the
+// scan measured of the track, accumulated over its life as log-odds. The terms and biases are
+// fitted by scripts/fit-vehicle-evidence from tracks labelled against ground truth; they are
+// written into config/tracker.yaml by that script, and the defaults here are its output.
+enum class EvidenceFeature : std::int8_t {
+  kLogPoints,      // [-] ln(returns of the track on the scan)
+  kLogRange,       // [-] ln(range of their centroid from the sensor / 1 m)
+  kHeightMax,      // [m] highest return above the local ground (3-D)
+  kHeightMedian,   // [m] median height above the local ground (3-D)
+  kHeightMin,      // [m] lowest (3-D): free space under a car body is low, under a crown high
+  kOverhang,       // [-] share of the returns with returns above preprocess.max_height in their
+                   //     ground cell (tree crowns, building fronts; 3-D, grid ground)
+  kLength,         // [m] the shape estimate of the reported hypothesis (0 if none)
+  kWidth,          // [m]
+  kSegmentExtent,  // [m] bounding-box diagonal of the largest segment holding the returns (walls)
+  kSpeed,          // [m/s] of the reported hypothesis' centre
+  kMover,          // [-] 1 if judged a mover
+  kSmall,          // [-] 1 if measured by its centroid (small object)
+  kCount
+};
+
+}  // namespace vtrack
+
+template <>
+struct vtrack::EnumNames<vtrack::EvidenceFeature> {
+  static constexpr std::array kNames{"log_points", "log_range", "height_max", "height_median",
+                                     "height_min", "overhang", "length", "width",
+                                     "segment_extent", "speed", "mover", "small"};
+};
+
+namespace vtrack {
+
+// One term of the per-scan logit: weight * ((feature - center) / scale)^power.
+struct EvidenceTerm {
+  EvidenceFeature feature = EvidenceFeature::kLogPoints;
+  int power = 1;
+  double center = 0.0;
+  double scale = 1.0;
+  double weight = 0.0;
+
+  template <class V>
+  void Visit(V& v) {
+    using namespace param;
+    v("feature", &feature, {"-", {}, "which measured feature"});
+    v("power", &power, {"-", Closed(1, 2), "1: linear, 2: quadratic (a window: e.g. a car's height)"});
+    v("center", &center, {"feature's unit", Finite(), "subtracted before the power (the training mean)"});
+    v("scale", &scale, {"feature's unit", Above(0), "divides after centring (the training std)"});
+    v("weight", &weight, {"-", Finite(), "fitted coefficient of the logistic model"});
+  }
+};
+
+enum class VehicleClassifier : std::int8_t { kRules, kEvidence };
+
+}  // namespace vtrack
+
+#include "tracker/core/vehicle_evidence_fit.h"  // the fitted defaults below (generated)
+
+template <>
+struct vtrack::EnumNames<vtrack::VehicleClassifier> {
+  static constexpr std::array kNames{"rules", "evidence"};
+};
+
+namespace vtrack {
+
+struct EvidenceParams {
+  static constexpr const char* kSection = "evidence";
+  static constexpr const char* kAbout =
+      "Vehicle evidence of each track: a fitted per-scan logistic model accumulated as log-odds";
+  VehicleClassifier classifier_3d = VehicleClassifier::kEvidence;
+  VehicleClassifier classifier_2d = VehicleClassifier::kRules;
+  double prior = evidence_fit::kPrior;
+  double scan_weight = evidence_fit::kScanWeight;
+  double max_log_odds = 6.0;
+  double vehicle_probability = 0.5;
+  double bias_3d = evidence_fit::kBias3D;
+  std::vector<EvidenceTerm> terms_3d = evidence_fit::kTerms3D;
+  double bias_2d = evidence_fit::kBias2D;
+  std::vector<EvidenceTerm> terms_2d = evidence_fit::kTerms2D;
+
+  template <class V>
+  void Visit(V& v) {
+    using namespace param;
+    v("classifier_3d", &classifier_3d, {"-", {}, "tracks from 3-D clouds: evidence (the accumulated vehicle probability decides) or rules (size and motion windows, classification.h); evidence: KITTI 0000 mht MOTA 0.40 against -0.22, urban_intersection 0.78 against 0.61 (docs/results.md)"});
+    v("classifier_2d", &classifier_2d, {"-", {}, "tracks from single-plane scans: rules, since the fitted single-plane model (footprint, outline, motion; no heights) takes wall pieces for car sides: paper_fig4_turn mht MOTA -0.18 against 0.19 with the rules"});
+    v("prior", &prior, {"-", Open(0, 1), "share of vehicle scans in the fitting set: the models' logits are posteriors at this prior, and a new track starts at it"});
+    v("scan_weight", &scan_weight, {"-", OpenClosed(0, 1), "each scan's log-likelihood ratio counts this much (scans of one object are far from independent); fitted"});
+    v("max_log_odds", &max_log_odds, {"-", Above(0), "the accumulated log-odds are clamped to +-this, so that a track can change its mind"});
+    v("vehicle_probability", &vehicle_probability, {"-", Open(0, 1), "a track is a vehicle from this accumulated probability on"});
+    v("bias_3d", &bias_3d, {"-", Finite(), "3-D scans: intercept of the per-scan logit"});
+    v("terms_3d", &terms_3d, {"-", {}, "3-D scans: the logit's terms (fitted)"});
+    v("bias_2d", &bias_2d, {"-", Finite(), "single-plane scans: intercept of the per-scan logit"});
+    v("terms_2d", &terms_2d, {"-", {}, "single-plane scans: the logit's terms (fitted)"});
+  }
+  bool Validate(std::string* error) const { return param::Validate(*this, error); }
+};
+
 struct TrackerParams {
   InputParams input;
   PreprocessParams preprocess;
@@ -570,6 +666,7 @@ struct TrackerParams {
   ShapeParams shape;
   TrackManagerParams manager;  // includes the mode (mht | ism | vasm | cv)
   DetectionParams detections;  // a detector's boxes: the input mode and their measurement model
+  EvidenceParams evidence;     // vehicle evidence of each track
 
   // Calls v(&section) for every component, in the order of config/tracker.yaml.
   template <class V>
@@ -588,6 +685,7 @@ struct TrackerParams {
     v(&shape);
     v(&manager);
     v(&detections);
+    v(&evidence);
   }
 
   // True if every component is valid; otherwise false and *error names the key and its value.

@@ -235,20 +235,23 @@ namespace {
 constexpr double kGroundLevelRadius = 20.0;  // [m]
 
 // Keeps the returns whose height above the ground (ground_of(i, height)) lies in
-// [min_h, max_h], storing that height; counts the others as ground.
-template <class GroundOf>
-void KeepAboveGround(double min_h, double max_h, GroundOf ground_of, WorldPoints* pts,
-                     PreprocessStats* stats) {
+// [min_h, max_h], storing that height; counts the others as ground. above(i, h) is called for
+// each return higher than max_h; cells (if not null) is compacted like the returns.
+template <class GroundOf, class Above>
+void KeepAboveGround(double min_h, double max_h, GroundOf ground_of, Above above, WorldPoints* pts,
+                     std::vector<std::int32_t>* cells, PreprocessStats* stats) {
   const std::size_t n = pts->size();
   std::size_t w = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const float h = pts->height[i] - ground_of(i);
+    if (h > max_h) above(i, h);
     if (h < min_h || h > max_h) continue;
     pts->x[w] = pts->x[i];
     pts->y[w] = pts->y[i];
     pts->height[w] = h;
     pts->index[w] = pts->index[i];
     pts->ring[w] = pts->ring[i];
+    if (cells != nullptr) (*cells)[w] = (*cells)[i];
     ++w;
   }
   stats->ground = static_cast<std::int64_t>(n - w);
@@ -265,7 +268,7 @@ void Preprocessor::RemoveGroundBand(WorldPoints* out, PreprocessStats* stats) co
   // Heights above a flat ground at ground_height_body.
   const float ground = static_cast<float>(params_.ground_height_body);
   KeepAboveGround(params_.min_height, params_.max_height, [ground](std::size_t) { return ground; },
-                  out, stats);
+                  [](std::size_t, float) {}, out, nullptr, stats);
 }
 
 void Preprocessor::RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts,
@@ -282,8 +285,20 @@ void Preprocessor::RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts,
                       std::numeric_limits<float>::quiet_NaN());
   // Locals: the stores below could alias the parameters, which would be reloaded per return.
   const double min_h = params_.min_height, max_h = params_.max_height;
-  KeepAboveGround(min_h, max_h,
-                  [&](std::size_t i) { return CellGround(grid, point_cell_[i], level); }, pts, stats);
+  cell_top_.assign(cell_ground_.size(), 0.0f);
+  KeepAboveGround(
+      min_h, max_h, [&](std::size_t i) { return CellGround(grid, point_cell_[i], level); },
+      [&](std::size_t i, float h) {
+        float& top = cell_top_[static_cast<std::size_t>(point_cell_[i])];
+        top = std::max(top, h);
+      },
+      pts, &point_cell_, stats);
+  // The overhang of each kept return: what its cell holds above max_height.
+  const std::size_t kept = pts->size();
+  pts->overhang.resize(kept);
+  for (std::size_t i = 0; i < kept; ++i) {
+    pts->overhang[i] = cell_top_[static_cast<std::size_t>(point_cell_[i])];
+  }
 }
 
 void Preprocessor::BinLowestReturns(const GroundGrid& grid, const WorldPoints& pts) {

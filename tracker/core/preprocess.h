@@ -43,6 +43,10 @@ struct WorldPoints {
   std::vector<float> height;           // [m] above the local ground (body z for 2-D scans)
   std::vector<std::int32_t> index;     // [-] index of the return in the scan
   std::vector<std::int16_t> ring;      // [-]
+  // [m] 3-D clouds, grid ground only (else empty): the highest return above the local ground in
+  // the return's ground cell, max_height or more included (tree crowns, building fronts); 0 if
+  // none lies above max_height there. A vehicle-evidence feature (vehicle_evidence.h).
+  std::vector<float> overhang;
 
   std::size_t size() const { return x.size(); }
   void clear();
@@ -120,7 +124,7 @@ class Preprocessor {
   // interval by a look-up, not a division per return (the same quotients, computed once).
   std::vector<double> fraction_;
   // Ground grid.
-  std::vector<float> cell_min_, cell_ground_, cell_bound_;
+  std::vector<float> cell_min_, cell_ground_, cell_bound_, cell_top_;
   std::vector<std::int32_t> point_cell_;
 };
 

@@ -65,6 +65,8 @@ struct Track {
   double box_score = 0.0;                 // [-] recency-weighted mean score of those boxes
                                           //     (TrackManager::Report, "score")
   double box_z = 0.0, box_height = 0.0;   // [m] the same mean of their bottom (world) and height
+  double vehicle_log_odds = 0.0;          // [-] accumulated vehicle evidence (vehicle_evidence.h)
+  bool evidence_3d = false;               // [-] the latest scan evidence came from a 3-D cloud
   std::vector<TrackHypothesis> hyps;
   int selected = 0;                       // index into hyps of the reported hypothesis
 };
@@ -91,6 +93,9 @@ struct TrackReport {
   // recency-weighted mean as score); NaN for a track no box measured (the LADAR tracks in 2-D).
   double z = std::numeric_limits<double>::quiet_NaN();
   double height = std::numeric_limits<double>::quiet_NaN();
+  // [-] probability that the track is a vehicle, from its accumulated scan evidence
+  // (vehicle_evidence.h; track_t.vehicle_probability).
+  double vehicle_probability = 0.0;
   std::vector<PredictedPose> prediction;  // t after the report time
 };
 

@@ -357,6 +357,7 @@ void TrackManager::AddTrack(Track t, TrackHypothesis h, std::int64_t utime) {
   t.state_utime = utime;
   t.last_update_utime = utime;
   t.num_updates = 1;
+  t.vehicle_log_odds = PriorLogOdds(evidence_);
   t.hyps.push_back(std::move(h));
   tracks_.push_back(std::move(t));
 }
@@ -367,6 +368,18 @@ OrientedBox TrackManager::Box(std::size_t index) const {
 }
 
 void TrackManager::Miss(std::size_t index) { ++tracks_[index].consecutive_misses; }
+
+double TrackManager::ObserveEvidence(std::size_t index, const ReturnEvidence& r,
+                                     EvidenceFeatures* features) {
+  Track& t = tracks_[index];
+  const TrackHypothesis& sel = t.hyps[static_cast<std::size_t>(t.selected)];
+  const EvidenceFeatures f = FeaturesOf(r, t, ekf_.Centre(sel.filter).speed);
+  const double logit = ScanLogit(evidence_, r.three_d, f);
+  t.vehicle_log_odds = AccumulateLogOdds(evidence_, t.vehicle_log_odds, logit);
+  t.evidence_3d = r.three_d;
+  if (features != nullptr) *features = f;
+  return logit;
+}
 
 bool TrackManager::Create(const PointSet& points, const Eigen::Vector2d& sensor_xy,
                           std::uint64_t seed) {
@@ -454,7 +467,8 @@ void TrackManager::Report(std::int64_t utime, std::vector<TrackReport>* out) con
       r.z = t.box_z;
       r.height = t.box_height;
     }
-    r.object_class = Classify(params_, t, vehicle_needs_box_, utime, vehicle_box_score_);
+    r.vehicle_probability = VehicleProbability(t.vehicle_log_odds);
+    r.object_class = Classify(params_, evidence_, t, vehicle_needs_box_, utime, vehicle_box_score_);
     if (r.object_class != ObjectClass::kVehicle && sel.length_est && sel.width_est) {
       // Clutter: its own size, not the vehicle default.
       r.length = *sel.length_est;

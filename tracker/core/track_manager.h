@@ -88,6 +88,7 @@
 #include "tracker/core/range_profile.h"
 #include "tracker/core/shape.h"
 #include "tracker/core/track.h"
+#include "tracker/core/vehicle_evidence.h"
 #include "tracker/core/parameters.h"
 
 namespace vtrack {
@@ -127,6 +128,13 @@ class TrackManager {
   // How tracks measured by a detector's boxes are classed (classification.h, Classify): a
   // vehicle from a mean box score of vehicle_box_score on; with needs_box (fused input) a track no
   // box has updated lately is other, whatever its size.
+  // The vehicle-evidence model (vehicle_evidence.h); before any call, the defaults.
+  void SetEvidence(const EvidenceParams& evidence) { evidence_ = evidence; }
+  // One scan's returns r of track index, after its update or creation: the features (with the
+  // track's state), the scan's logit added to the track's log-odds; the features in *features
+  // if not null. Returns the scan's logit.
+  double ObserveEvidence(std::size_t index, const ReturnEvidence& r,
+                         EvidenceFeatures* features = nullptr);
   void SetBoxClassRule(bool needs_box, double vehicle_box_score) {
     vehicle_needs_box_ = needs_box;
     vehicle_box_score_ = vehicle_box_score;
@@ -178,6 +186,7 @@ class TrackManager {
   MoverTest mover_test_;
   std::vector<Track> tracks_;
   std::int64_t next_id_ = 1;
+  EvidenceParams evidence_;
   bool vehicle_needs_box_ = false;
   double vehicle_box_score_ = -std::numeric_limits<double>::infinity();  // [-] detector's scale
 };

@@ -51,6 +51,7 @@ Tracker::Tracker(const TrackerParams& params, bool debug)
   if (!params_.Validate(&error)) throw std::invalid_argument(error);
   ekf_ = std::make_unique<Ekf>(params_.ism, params_.vasm, params_.ekf, params_.cv);
   manager_ = std::make_unique<TrackManager>(params_.manager, *ekf_, params_.fit, params_.shape);
+  manager_->SetEvidence(params_.evidence);
   manager_->SetBoxClassRule(params_.detections.mode == InputMode::kFused &&
                                 params_.detections.fused_vehicle_needs_box,
                             params_.detections.birth_score);
@@ -157,13 +158,14 @@ bool Tracker::Process(const LadarScan& scan, bool extrapolate, ScanOutput* out) 
   segmenter_.Run(points_, scan.num_rings <= 1, pre.sensor_xy, &segments_);
   JoinGrazingPieces(points_, pre.sensor_xy, params_.grazing, &segments_);
   out->num_segments = static_cast<std::int32_t>(segments_.segments.size());
+  IndexSegments();
   // Association with the tracks predicted to the middle of the sweep.
   manager_->Predict(scan.utime + scan.sweep_duration_us / 2, &predicted_);
   associator_.Run(predicted_, points_, segments_, pre.sensor_xy, &association_);
   MarkUnobserved(scan, extrapolate);
   // Each track updated with its returns; new tracks from what is left; life cycle; report.
   UpdateTracks(scan, pre.sensor_xy, out);
-  CreateTracks(scan, pre.sensor_xy);
+  CreateTracks(scan, pre.sensor_xy, out);
   manager_->EndScan(scan.utime);
   manager_->Report(scan.utime, &out->tracks);
   return true;
@@ -265,10 +267,39 @@ void Tracker::UpdateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_
     manager_->Update(j, point_set_, sensor_xy, RansacSeed(scan.utime, manager_->tracks()[j].id),
                      debug_ ? &dbg : nullptr, multi_ring ? &profile_ : nullptr);
     if (debug_) out->debug.push_back(std::move(dbg));
+    ObserveEvidence(j, idx, sensor_xy, multi_ring, out);
   }
 }
 
-void Tracker::CreateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_xy) {
+void Tracker::IndexSegments() {
+  segment_of_.assign(points_.size(), -1);
+  segment_extent_.resize(segments_.segments.size());
+  for (std::size_t s = 0; s < segments_.segments.size(); ++s) {
+    const Segment& seg = segments_.segments[s];
+    segment_extent_[s] = static_cast<float>((seg.max - seg.min).norm());
+    for (std::int32_t k = seg.begin; k < seg.end; ++k) {
+      segment_of_[static_cast<std::size_t>(segments_.point[static_cast<std::size_t>(k)])] =
+          static_cast<std::int32_t>(s);
+    }
+  }
+}
+
+void Tracker::ObserveEvidence(std::size_t index, const std::vector<std::int32_t>& idx,
+                              const Eigen::Vector2d& sensor_xy, bool three_d, ScanOutput* out) {
+  const ReturnEvidence r =
+      MeasureReturns(points_, idx, segment_of_, segment_extent_, sensor_xy, three_d, &evidence_scratch_);
+  ScanOutput::EvidenceRow row;
+  row.logit = manager_->ObserveEvidence(index, r, record_evidence_ ? &row.features : nullptr);
+  if (!record_evidence_) return;
+  const Track& t = manager_->tracks()[index];
+  row.track_id = t.id;
+  row.three_d = three_d;
+  row.log_odds = t.vehicle_log_odds;
+  out->evidence.push_back(row);
+}
+
+void Tracker::CreateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_xy,
+                           ScanOutput* out) {
   auto& objs = association_.new_objects;
   OrderNewObjects(points_, params_.manager.small_object_extent, &objs);
   created_.Clear();
@@ -278,7 +309,9 @@ void Tracker::CreateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_
     outline_.Extract(points_, idx, scan, sensor_xy, &point_set_);
     if (point_set_.size() == 0) continue;
     if (manager_->Create(point_set_, sensor_xy, RansacSeed(scan.utime, -1 - static_cast<std::int64_t>(k)))) {
-      created_.Add(manager_->Box(manager_->tracks().size() - 1));
+      const std::size_t index = manager_->tracks().size() - 1;
+      created_.Add(manager_->Box(index));
+      ObserveEvidence(index, idx, sensor_xy, scan.num_rings > 1, out);
     }
   }
 }

@@ -47,6 +47,16 @@ struct ScanOutput {
   std::int32_t num_segments = 0;
   std::vector<TrackDebug> debug;
   PreprocessStats stats;
+  // Filled when evidence recording is on (SetRecordEvidence): every track given returns by the
+  // scan, its features and logit (the fitting set of scripts/fit-vehicle-evidence).
+  struct EvidenceRow {
+    std::int64_t track_id = 0;
+    bool three_d = false;
+    EvidenceFeatures features{};
+    double logit = 0.0;       // [-] the scan's
+    double log_odds = 0.0;    // [-] the track's, after it
+  };
+  std::vector<EvidenceRow> evidence;
 };
 
 // A first track id larger than every id of a tracker started earlier (for a process that may be
@@ -80,6 +90,9 @@ class Tracker {
   // Events since the last call (for rate-limited warnings).
   std::vector<TrackerEvent> TakeEvents() { return rejects_.TakeEvents(); }
 
+  // Records every scan's vehicle-evidence features in ScanOutput::evidence.
+  void SetRecordEvidence(bool on) { record_evidence_ = on; }
+
   // The id of the next track (see TrackManager::SetNextId). Throws std::invalid_argument if < 1.
   void SetFirstTrackId(std::int64_t id);
 
@@ -102,7 +115,12 @@ class Tracker {
   // Updates every track with its returns (a miss if none, unless it was not observed).
   void UpdateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_xy, ScanOutput* out);
   // New tracks from the objects association left over.
-  void CreateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_xy);
+  void CreateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_xy, ScanOutput* out);
+  // The segment of every return and each segment's extent (for the vehicle evidence).
+  void IndexSegments();
+  // The vehicle evidence of track index from its returns idx on this scan.
+  void ObserveEvidence(std::size_t index, const std::vector<std::int32_t>& idx,
+                       const Eigen::Vector2d& sensor_xy, bool three_d, ScanOutput* out);
 
   TrackerParams params_;
   bool debug_;
@@ -125,6 +143,10 @@ class Tracker {
   RangeProfile profile_;  // nearest return per bearing of the scan being processed
   std::vector<char> unobserved_;  // per track: in a lost wedge of the scan being processed
   std::vector<AzimuthWedge> lost_world_;  // the scan's lost wedges as world bearings [rad]
+  std::vector<std::int32_t> segment_of_;  // per return of points_: its segment, or -1
+  std::vector<float> segment_extent_;     // [m] per segment: bounding-box diagonal
+  std::vector<float> evidence_scratch_;
+  bool record_evidence_ = false;
   std::int64_t returns_processed_ = 0;
 };
 

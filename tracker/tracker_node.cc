@@ -25,7 +25,7 @@ TrackerNode::TrackerNode(const TrackerParams& params, NodeOptions options, Publi
       throw std::invalid_argument("cannot write the evidence CSV '" + options_.evidence_csv + "'");
     }
     evidence_csv_.precision(7);
-    evidence_csv_ << "utime,track_id,three_d";
+    evidence_csv_ << "utime,track_id,x,y,three_d";
     for (std::size_t k = 0; k < kNumEvidenceFeatures; ++k) {
       evidence_csv_ << ',' << NameOf(static_cast<EvidenceFeature>(k));
     }
@@ -36,7 +36,13 @@ TrackerNode::TrackerNode(const TrackerParams& params, NodeOptions options, Publi
 
 void TrackerNode::WriteEvidence(const ScanOutput& o) {
   for (const ScanOutput::EvidenceRow& r : o.evidence) {
-    evidence_csv_ << o.utime << ',' << r.track_id << ',' << (r.three_d ? 1 : 0);
+    // The track's reported centre (it is reported: every track is, after its update).
+    const auto t = std::find_if(o.tracks.begin(), o.tracks.end(),
+                                [&](const TrackReport& tr) { return tr.id == r.track_id; });
+    evidence_csv_ << o.utime << ',' << r.track_id << ',';
+    if (t != o.tracks.end()) evidence_csv_ << t->x << ',' << t->y;
+    else evidence_csv_ << "nan,nan";  // deleted by the same scan's life cycle
+    evidence_csv_ << ',' << (r.three_d ? 1 : 0);
     for (const double f : r.features) evidence_csv_ << ',' << f;
     evidence_csv_ << ',' << r.logit << ',' << r.log_odds << '\n';
   }

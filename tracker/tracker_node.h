@@ -33,7 +33,7 @@ struct NodeOptions {
   std::string status_channel = "TRACKER_STATUS";
   bool debug = false;  // publish TRACK_DEBUG
   // If not empty: every scan's vehicle-evidence features of every track it gave returns, as CSV
-  // (utime, track_id, three_d, the features by name, logit, log_odds): the fitting set of
+  // (utime, track_id, x, y, three_d, the features by name, logit, log_odds): the fitting set of
   // scripts/fit-vehicle-evidence.
   std::string evidence_csv;
   // The first track id. Offline: 1 (reruns identical). Live: FirstTrackIdAt(wall clock), so

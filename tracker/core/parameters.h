@@ -565,8 +565,12 @@ enum class EvidenceFeature : std::int8_t {
   kHeightMax,      // [m] highest return above the local ground (3-D)
   kHeightMedian,   // [m] median height above the local ground (3-D)
   kHeightMin,      // [m] lowest (3-D): free space under a car body is low, under a crown high
-  kOverhang,       // [-] share of the returns with returns above preprocess.max_height in their
-                   //     ground cell (tree crowns, building fronts; 3-D, grid ground)
+  kColumnTop,      // [m] median over the returns of the highest return in their ground cell,
+                   //     above preprocess.max_height too (a car's roof against a crown or a
+                   //     building; 3-D, grid ground), at most 10 m
+  kTopBeam,        // [-] ln(1 + returns from the scan's highest beam): the object reaches above
+                   //     what that beam sees at its range (a tree or a wall close by looks no
+                   //     taller than the beam; a car stays under it; 3-D)
   kLength,         // [m] the shape estimate of the reported hypothesis (0 if none)
   kWidth,          // [m]
   kSegmentExtent,  // [m] bounding-box diagonal of the largest segment holding the returns (walls)
@@ -581,7 +585,7 @@ enum class EvidenceFeature : std::int8_t {
 template <>
 struct vtrack::EnumNames<vtrack::EvidenceFeature> {
   static constexpr std::array kNames{"log_points", "log_range", "height_max", "height_median",
-                                     "height_min", "overhang", "length", "width",
+                                     "height_min", "column_top", "top_beam", "length", "width",
                                      "segment_extent", "speed", "mover", "small"};
 };
 
@@ -607,8 +611,16 @@ struct EvidenceTerm {
 };
 
 enum class VehicleClassifier : std::int8_t { kRules, kEvidence };
+// How a track's scans add up (vehicle_evidence.h): a discounted sum of their log-likelihood
+// ratios, or an exponential average of their log posterior odds.
+enum class EvidenceAccumulation : std::int8_t { kSum, kAverage };
 
 }  // namespace vtrack
+
+template <>
+struct vtrack::EnumNames<vtrack::EvidenceAccumulation> {
+  static constexpr std::array kNames{"sum", "average"};
+};
 
 #include "tracker/core/vehicle_evidence_fit.h"  // the fitted defaults below (generated)
 
@@ -626,6 +638,7 @@ struct EvidenceParams {
   VehicleClassifier classifier_3d = VehicleClassifier::kEvidence;
   VehicleClassifier classifier_2d = VehicleClassifier::kRules;
   double prior = evidence_fit::kPrior;
+  EvidenceAccumulation accumulation = evidence_fit::kAccumulation;
   double scan_weight = evidence_fit::kScanWeight;
   double max_log_odds = 6.0;
   double vehicle_probability = 0.5;
@@ -637,10 +650,11 @@ struct EvidenceParams {
   template <class V>
   void Visit(V& v) {
     using namespace param;
-    v("classifier_3d", &classifier_3d, {"-", {}, "tracks from 3-D clouds: evidence (the accumulated vehicle probability decides) or rules (size and motion windows, classification.h); evidence: KITTI 0000 mht MOTA 0.40 against -0.22, urban_intersection 0.78 against 0.61 (docs/results.md)"});
-    v("classifier_2d", &classifier_2d, {"-", {}, "tracks from single-plane scans: rules, since the fitted single-plane model (footprint, outline, motion; no heights) takes wall pieces for car sides: paper_fig4_turn mht MOTA -0.18 against 0.19 with the rules"});
+    v("classifier_3d", &classifier_3d, {"-", {}, "tracks from 3-D clouds: evidence (the accumulated vehicle probability decides) or rules (size and motion windows, classification.h); evidence: KITTI 0000 mht MOTA 0.52 against -0.22, urban_intersection 0.82 against 0.61"});
+    v("classifier_2d", &classifier_2d, {"-", {}, "tracks from single-plane scans: rules, since the fitted single-plane model (footprint, outline, motion; no heights) helps one paper scene and costs three (mht MOTA fig4 0.60 against 0.19, fig5 0.56 against 0.58, fig6 0.56 against 0.57, reversing_and_skid_steer 0.20 against 0.23)"});
     v("prior", &prior, {"-", Open(0, 1), "share of vehicle scans in the fitting set: the models' logits are posteriors at this prior, and a new track starts at it"});
-    v("scan_weight", &scan_weight, {"-", OpenClosed(0, 1), "each scan's log-likelihood ratio counts this much (scans of one object are far from independent); fitted"});
+    v("accumulation", &accumulation, {"-", {}, "sum: L += scan_weight (l - logit(prior)); average: L += scan_weight (l - L), an exponential average of the scans' log posterior odds (scans of one object are far from independent); fitted (the better log-likelihood)"});
+    v("scan_weight", &scan_weight, {"-", OpenClosed(0, 1), "the weight of each scan in the accumulation; fitted"});
     v("max_log_odds", &max_log_odds, {"-", Above(0), "the accumulated log-odds are clamped to +-this, so that a track can change its mind"});
     v("vehicle_probability", &vehicle_probability, {"-", Open(0, 1), "a track is a vehicle from this accumulated probability on"});
     v("bias_3d", &bias_3d, {"-", Finite(), "3-D scans: intercept of the per-scan logit"});

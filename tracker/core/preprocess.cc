@@ -17,6 +17,7 @@ void WorldPoints::clear() {
   x.clear();
   y.clear();
   height.clear();
+  column_top.clear();
   index.clear();
   ring.clear();
 }
@@ -235,17 +236,19 @@ namespace {
 constexpr double kGroundLevelRadius = 20.0;  // [m]
 
 // Keeps the returns whose height above the ground (ground_of(i, height)) lies in
-// [min_h, max_h], storing that height; counts the others as ground. above(i, h) is called for
-// each return higher than max_h; cells (if not null) is compacted like the returns.
-template <class GroundOf, class Above>
-void KeepAboveGround(double min_h, double max_h, GroundOf ground_of, Above above, WorldPoints* pts,
+// [min_h, max_h], storing that height; counts the others as ground. column(i, h) is called for
+// each return at least min_h high (kept or above max_h); cells (if not null) is compacted like
+// the returns.
+template <class GroundOf, class Column>
+void KeepAboveGround(double min_h, double max_h, GroundOf ground_of, Column column, WorldPoints* pts,
                      std::vector<std::int32_t>* cells, PreprocessStats* stats) {
   const std::size_t n = pts->size();
   std::size_t w = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const float h = pts->height[i] - ground_of(i);
-    if (h > max_h) above(i, h);
-    if (h < min_h || h > max_h) continue;
+    if (h < min_h) continue;
+    column(i, h);
+    if (h > max_h) continue;
     pts->x[w] = pts->x[i];
     pts->y[w] = pts->y[i];
     pts->height[w] = h;
@@ -293,11 +296,11 @@ void Preprocessor::RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts,
         top = std::max(top, h);
       },
       pts, &point_cell_, stats);
-  // The overhang of each kept return: what its cell holds above max_height.
+  // The top of each kept return's column: the highest return of its cell.
   const std::size_t kept = pts->size();
-  pts->overhang.resize(kept);
+  pts->column_top.resize(kept);
   for (std::size_t i = 0; i < kept; ++i) {
-    pts->overhang[i] = cell_top_[static_cast<std::size_t>(point_cell_[i])];
+    pts->column_top[i] = cell_top_[static_cast<std::size_t>(point_cell_[i])];
   }
 }
 

@@ -43,10 +43,11 @@ struct WorldPoints {
   std::vector<float> height;           // [m] above the local ground (body z for 2-D scans)
   std::vector<std::int32_t> index;     // [-] index of the return in the scan
   std::vector<std::int16_t> ring;      // [-]
-  // [m] 3-D clouds, grid ground only (else empty): the highest return above the local ground in
-  // the return's ground cell, max_height or more included (tree crowns, building fronts); 0 if
-  // none lies above max_height there. A vehicle-evidence feature (vehicle_evidence.h).
-  std::vector<float> overhang;
+  // [m] 3-D clouds, grid ground only (else empty): the height above the local ground of the
+  // highest return in the return's ground cell, those above max_height included (a car's roof,
+  // a van's, a truck's, a tree crown, a building front). A vehicle-evidence feature
+  // (vehicle_evidence.h).
+  std::vector<float> column_top;
 
   std::size_t size() const { return x.size(); }
   void clear();

@@ -159,6 +159,7 @@ bool Tracker::Process(const LadarScan& scan, bool extrapolate, ScanOutput* out) 
   JoinGrazingPieces(points_, pre.sensor_xy, params_.grazing, &segments_);
   out->num_segments = static_cast<std::int32_t>(segments_.segments.size());
   IndexSegments();
+  top_ring_ = TopRing(scan);
   // Association with the tracks predicted to the middle of the sweep.
   manager_->Predict(scan.utime + scan.sweep_duration_us / 2, &predicted_);
   associator_.Run(predicted_, points_, segments_, pre.sensor_xy, &association_);
@@ -287,7 +288,8 @@ void Tracker::IndexSegments() {
 void Tracker::ObserveEvidence(std::size_t index, const std::vector<std::int32_t>& idx,
                               const Eigen::Vector2d& sensor_xy, bool three_d, ScanOutput* out) {
   const ReturnEvidence r =
-      MeasureReturns(points_, idx, segment_of_, segment_extent_, sensor_xy, three_d, &evidence_scratch_);
+      MeasureReturns(points_, idx, segment_of_, segment_extent_, sensor_xy, three_d, top_ring_,
+                     &evidence_scratch_);
   ScanOutput::EvidenceRow row;
   row.logit = manager_->ObserveEvidence(index, r, record_evidence_ ? &row.features : nullptr);
   if (!record_evidence_) return;

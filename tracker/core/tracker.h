@@ -146,6 +146,7 @@ class Tracker {
   std::vector<std::int32_t> segment_of_;  // per return of points_: its segment, or -1
   std::vector<float> segment_extent_;     // [m] per segment: bounding-box diagonal
   std::vector<float> evidence_scratch_;
+  int top_ring_ = -1;                     // TopRing of the scan being processed
   bool record_evidence_ = false;
   std::int64_t returns_processed_ = 0;
 };

@@ -2,47 +2,87 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "tracker/core/preprocess.h"
+#include "tracker/core/scan.h"
 #include "tracker/core/track.h"
 
 namespace vtrack {
+namespace {
+
+// [m] Above this a column says nothing more (a crown or a building either way), and a far
+// outlier return would only add leverage to the fit.
+constexpr float kMaxColumnTop = 10.0f;
+
+}  // namespace
+
+int TopRing(const LadarScan& scan) {
+  if (scan.num_rings <= 1 || scan.ring.size() != scan.size()) return -1;
+  // Every 8th return: the mean elevation of a ring is settled long before (a ring has ~2000
+  // returns per sweep), at an eighth of the cost.
+  constexpr std::size_t kStride = 8;
+  std::vector<double> sum(static_cast<std::size_t>(scan.num_rings), 0.0);
+  std::vector<int> count(sum.size(), 0);
+  for (std::size_t i = 0; i < scan.size(); i += kStride) {
+    const int r = scan.ring[i];
+    const double rho = std::hypot(scan.x[i], scan.y[i]);
+    if (r < 0 || r >= scan.num_rings || !(rho > 1.0) || !std::isfinite(scan.z[i])) continue;
+    sum[static_cast<std::size_t>(r)] += scan.z[i] / rho;  // tan(elevation)
+    ++count[static_cast<std::size_t>(r)];
+  }
+  int top = -1;
+  double best = -std::numeric_limits<double>::infinity();
+  for (std::size_t r = 0; r < sum.size(); ++r) {
+    if (count[r] == 0) continue;
+    const double mean = sum[r] / count[r];
+    if (mean > best) {
+      best = mean;
+      top = static_cast<int>(r);
+    }
+  }
+  return top;
+}
 
 ReturnEvidence MeasureReturns(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
                               const std::vector<std::int32_t>& segment_of,
                               const std::vector<float>& segment_extent,
-                              const Eigen::Vector2d& sensor_xy, bool three_d,
+                              const Eigen::Vector2d& sensor_xy, bool three_d, int top_ring,
                               std::vector<float>* scratch) {
   ReturnEvidence r;
   r.three_d = three_d;
   r.num_points = static_cast<int>(idx.size());
   if (idx.empty()) return r;
   double sx = 0.0, sy = 0.0;
-  int overhung = 0;
   float extent = 0.0f;
   scratch->clear();
-  const bool has_overhang = pts.overhang.size() == pts.size();
   for (const std::int32_t i : idx) {
     const auto k = static_cast<std::size_t>(i);
     sx += pts.x[k];
     sy += pts.y[k];
     scratch->push_back(pts.height[k]);
-    if (has_overhang && pts.overhang[k] > 0.0f) ++overhung;
+    if (pts.ring[k] == top_ring) ++r.top_beam;
     const std::int32_t s = k < segment_of.size() ? segment_of[k] : -1;
     if (s >= 0) extent = std::max(extent, segment_extent[static_cast<std::size_t>(s)]);
   }
   const double n = static_cast<double>(idx.size());
   r.range = (Eigen::Vector2d(sx / n, sy / n) - sensor_xy).norm();
   r.segment_extent = extent;
-  r.overhang = overhung / n;
-  if (three_d) {
-    auto& h = *scratch;
-    const auto [lo, hi] = std::minmax_element(h.begin(), h.end());
-    r.height_min = *lo;
-    r.height_max = *hi;
-    auto mid = h.begin() + static_cast<std::ptrdiff_t>(h.size() / 2);
-    std::nth_element(h.begin(), mid, h.end());
-    r.height_median = *mid;
+  if (!three_d) return r;
+  auto& h = *scratch;
+  const auto half = static_cast<std::ptrdiff_t>(h.size() / 2);
+  const auto [lo, hi] = std::minmax_element(h.begin(), h.end());
+  r.height_min = *lo;
+  r.height_max = *hi;
+  std::nth_element(h.begin(), h.begin() + half, h.end());
+  r.height_median = h[static_cast<std::size_t>(half)];
+  if (pts.column_top.size() == pts.size()) {
+    h.clear();
+    for (const std::int32_t i : idx) h.push_back(pts.column_top[static_cast<std::size_t>(i)]);
+    std::nth_element(h.begin(), h.begin() + half, h.end());
+    r.column_top = std::min(kMaxColumnTop, h[static_cast<std::size_t>(half)]);
+  } else {
+    r.column_top = r.height_max;  // no grid ground: the returns' own top
   }
   return r;
 }
@@ -56,7 +96,8 @@ EvidenceFeatures FeaturesOf(const ReturnEvidence& r, const Track& t, double spee
   set(EvidenceFeature::kHeightMax, r.height_max);
   set(EvidenceFeature::kHeightMedian, r.height_median);
   set(EvidenceFeature::kHeightMin, r.height_min);
-  set(EvidenceFeature::kOverhang, r.overhang);
+  set(EvidenceFeature::kColumnTop, r.column_top);
+  set(EvidenceFeature::kTopBeam, std::log1p(static_cast<double>(r.top_beam)));
   set(EvidenceFeature::kLength, sel.length_est.value_or(0.0));
   set(EvidenceFeature::kWidth, sel.width_est.value_or(0.0));
   set(EvidenceFeature::kSegmentExtent, r.segment_extent);
@@ -79,7 +120,8 @@ double ScanLogit(const EvidenceParams& p, bool three_d, const EvidenceFeatures& 
 double PriorLogOdds(const EvidenceParams& p) { return std::log(p.prior / (1.0 - p.prior)); }
 
 double AccumulateLogOdds(const EvidenceParams& p, double log_odds, double scan_logit) {
-  const double l = log_odds + p.scan_weight * (scan_logit - PriorLogOdds(p));
+  const double from = p.accumulation == EvidenceAccumulation::kSum ? PriorLogOdds(p) : log_odds;
+  const double l = log_odds + p.scan_weight * (scan_logit - from);
   return std::clamp(l, -p.max_log_odds, p.max_log_odds);
 }
 

@@ -2,16 +2,19 @@
 // or a pole, from what the scans measured of it, accumulated over its life.
 //
 // Per scan that gives the track returns, a feature vector f (EvidenceFeature, parameters.h):
-// the returns' height profile above the local ground (3-D clouds), their number and range, the
-// overhang above them, the extent of the segment they belong to, and the track's own footprint
-// and motion. A logistic model gives the scan's log posterior odds at the fitting set's prior pi,
+// the returns' height profile above the local ground (3-D clouds), their number and range, how
+// high their columns reach (crowns and building fronts above max_height), the extent of the
+// segment they belong to, and the track's own footprint and motion. A logistic model gives the scan's log posterior odds at the fitting set's prior pi,
 //   l(f) = bias + sum_k w_k ((f_k - c_k) / s_k)^p_k,
 // one model for 3-D clouds and one for single-plane scans (which measure no heights). The
-// track's log-odds start at logit(pi) and add each scan's log-likelihood ratio, discounted by
-// scan_weight a (successive scans of one object are strongly correlated; a is fitted):
-//   L <- clamp(L + a (l(f) - logit(pi)), -max_log_odds, +max_log_odds),
-// and the track's vehicle probability is sigmoid(L). The terms, pi and a are fitted by
-// scripts/fit-vehicle-evidence; nothing here is tuned by hand.
+// track's log-odds L start at logit(pi); each scan moves them by scan_weight a, either adding
+// its log-likelihood ratio (accumulation: sum) or moving towards its log posterior odds
+// (average, an exponential average: successive scans of one object are strongly correlated, and
+// a sum of their ratios turns a run of weak evidence into certainty):
+//   sum:     L <- clamp(L + a (l(f) - logit(pi)), -max_log_odds, +max_log_odds),
+//   average: L <- clamp(L + a (l(f) - L), ...),
+// and the track's vehicle probability is sigmoid(L). The terms, pi, the accumulation and a are
+// fitted by scripts/fit-vehicle-evidence; nothing here is tuned by hand.
 #pragma once
 
 #include <array>
@@ -24,6 +27,7 @@
 
 namespace vtrack {
 
+struct LadarScan;
 struct Track;
 struct WorldPoints;
 
@@ -38,16 +42,23 @@ struct ReturnEvidence {
   double height_max = 0.0;       // [m] above the local ground (3-D; 0 otherwise)
   double height_median = 0.0;    // [m]
   double height_min = 0.0;       // [m]
-  double overhang = 0.0;         // [-] share with returns above max_height in their cell
+  double column_top = 0.0;       // [m] median of their cells' highest returns, at most 10 m
+  int top_beam = 0;              // [-] of them from the scan's highest beam
   double segment_extent = 0.0;   // [m]
 };
 
+// The ring of a 3-D scan's highest beam: the largest mean elevation over a sample of its returns
+// (ring numbers run up or down depending on the sensor and its driver); -1 for a single-plane
+// scan or none found.
+int TopRing(const LadarScan& scan);
+
 // The returns idx of pts (non-empty), with segment_of[i] the segment index of return i (-1 for
-// none) and segment_extent[s] each segment's bounding-box diagonal. scratch: reused buffer.
+// none) and segment_extent[s] each segment's bounding-box diagonal; top_ring: TopRing of the
+// scan. scratch: reused buffer.
 ReturnEvidence MeasureReturns(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
                               const std::vector<std::int32_t>& segment_of,
                               const std::vector<float>& segment_extent,
-                              const Eigen::Vector2d& sensor_xy, bool three_d,
+                              const Eigen::Vector2d& sensor_xy, bool three_d, int top_ring,
                               std::vector<float>* scratch);
 
 // The full feature vector: the returns' features and the track's state after its update

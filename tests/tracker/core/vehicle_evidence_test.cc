@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "tracker/core/preprocess.h"
+#include "tracker/core/scan.h"
 #include "tracker/core/track.h"
 
 namespace vtrack {
@@ -19,6 +20,7 @@ TEST(VehicleEvidence, LogitIsTheSumOfItsTermsAndAccumulationIsDiscountedAndClamp
   EvidenceParams p;
   p.prior = 0.2;
   p.scan_weight = 0.25;
+  p.accumulation = EvidenceAccumulation::kSum;
   p.max_log_odds = 3.0;
   p.bias_3d = 0.5;
   p.bias_2d = 0.0;
@@ -42,19 +44,28 @@ TEST(VehicleEvidence, LogitIsTheSumOfItsTermsAndAccumulationIsDiscountedAndClamp
   // ... and from the clamp, scans of logit -5 bring it down as fast as the clamp allows.
   L = AccumulateLogOdds(p, L, -5.0);
   EXPECT_NEAR(L, 3.0 + 0.25 * (-5.0 - l0), 1e-12);
+  // Averaging: L moves a quarter of the way to each scan's logit: after n scans of logit 1 from
+  // l0, L = 1 + (l0 - 1) 0.75^n.
+  p.accumulation = EvidenceAccumulation::kAverage;
+  L = PriorLogOdds(p);
+  for (int n = 1; n <= 20; ++n) {
+    L = AccumulateLogOdds(p, L, 1.0);
+    EXPECT_NEAR(L, 1.0 + (l0 - 1.0) * std::pow(0.75, n), 1e-12) << n;
+  }
   EXPECT_NEAR(VehicleProbability(0.0), 0.5, 1e-15);
   EXPECT_NEAR(VehicleProbability(std::log(3.0)), 0.75, 1e-12);
 }
 
-TEST(VehicleEvidence, ReturnsGiveTheirHeightProfileOverhangRangeAndSegmentExtent) {
+TEST(VehicleEvidence, ReturnsGiveTheirHeightProfileColumnTopRangeAndSegmentExtent) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> height(0.3f, 1.6f), xy(-1.0f, 1.0f);
   WorldPoints pts;
   std::vector<float> heights;
   for (int i = 0; i < 101; ++i) {
     const float h = height(rng);
-    pts.push_back(20.0 + xy(rng), 5.0 + xy(rng), h, i, 0);
-    pts.overhang.push_back(i % 4 == 0 ? 4.5f : 0.0f);  // 26 of 101 under something tall
+    pts.push_back(20.0 + xy(rng), 5.0 + xy(rng), h, i, static_cast<std::int16_t>(i % 8));  // 13 on ring 3
+    // Column tops: 26 of 101 under a crown 14 m high (clipped to 10 m), the rest their own top.
+    pts.column_top.push_back(i % 4 == 0 ? 14.0f : 1.7f);
   }
   std::vector<std::int32_t> idx(101);
   for (int i = 0; i < 101; ++i) idx[static_cast<std::size_t>(i)] = i;
@@ -64,7 +75,7 @@ TEST(VehicleEvidence, ReturnsGiveTheirHeightProfileOverhangRangeAndSegmentExtent
   const std::vector<float> extent = {3.0f, 7.5f};
   std::vector<float> scratch;
   const ReturnEvidence r =
-      MeasureReturns(pts, idx, segment_of, extent, Eigen::Vector2d(2.0, 5.0), true, &scratch);
+      MeasureReturns(pts, idx, segment_of, extent, Eigen::Vector2d(2.0, 5.0), true, 3, &scratch);
 
   std::vector<float> sorted = pts.height;
   std::sort(sorted.begin(), sorted.end());
@@ -77,15 +88,46 @@ TEST(VehicleEvidence, ReturnsGiveTheirHeightProfileOverhangRangeAndSegmentExtent
   EXPECT_FLOAT_EQ(r.height_min, sorted.front());
   EXPECT_FLOAT_EQ(r.height_max, sorted.back());
   EXPECT_FLOAT_EQ(r.height_median, sorted[50]);
-  EXPECT_NEAR(r.overhang, 26.0 / 101.0, 1e-12);
+  EXPECT_FLOAT_EQ(r.column_top, 1.7f);  // the median: 75 of 101 at 1.7 m
+  for (int i = 0; i < 60; ++i) pts.column_top[static_cast<std::size_t>(i)] = 14.0f;
+  const ReturnEvidence under =
+      MeasureReturns(pts, idx, segment_of, extent, Eigen::Vector2d(2.0, 5.0), true, 3, &scratch);
+  EXPECT_FLOAT_EQ(under.column_top, 10.0f);  // 60 of 101 at 14 m: the median, clipped
   EXPECT_NEAR(r.range, std::hypot(cx - 2.0, cy - 5.0), 1e-9);
   EXPECT_FLOAT_EQ(r.segment_extent, 7.5f);
+  EXPECT_EQ(r.top_beam, 13);
 
   // Single-plane: no heights.
   const ReturnEvidence flat =
-      MeasureReturns(pts, idx, segment_of, extent, Eigen::Vector2d(2.0, 5.0), false, &scratch);
+      MeasureReturns(pts, idx, segment_of, extent, Eigen::Vector2d(2.0, 5.0), false, 3, &scratch);
   EXPECT_EQ(flat.height_max, 0.0);
   EXPECT_EQ(flat.height_median, 0.0);
+}
+
+TEST(VehicleEvidence, TopRingIsTheHighestBeamWhicheverWayRingsAreNumbered) {
+  // Eight beams from +2 deg down by 3 deg, numbered upwards (ring 7 = +2 deg) or downwards.
+  for (const bool upwards : {true, false}) {
+    LadarScan scan;
+    scan.num_rings = 8;
+    for (int k = 0; k < 8; ++k) {
+      const double elevation = (2.0 - 3.0 * k) * M_PI / 180.0;
+      for (int a = 0; a < 360; ++a) {
+        const double range = 5.0 + (a % 37), az = a * M_PI / 180.0;
+        scan.x.push_back(static_cast<float>(range * std::cos(elevation) * std::cos(az)));
+        scan.y.push_back(static_cast<float>(range * std::cos(elevation) * std::sin(az)));
+        scan.z.push_back(static_cast<float>(range * std::sin(elevation)));
+        scan.ring.push_back(static_cast<std::int16_t>(upwards ? 7 - k : k));
+      }
+    }
+    EXPECT_EQ(TopRing(scan), upwards ? 7 : 0);
+  }
+  LadarScan flat;
+  flat.num_rings = 1;
+  flat.x = {1.0f};
+  flat.y = {2.0f};
+  flat.z = {0.0f};
+  flat.ring = {0};
+  EXPECT_EQ(TopRing(flat), -1);
 }
 
 }  // namespace

@@ -82,6 +82,7 @@ SceneTrack TrackFromMsg(const vtrack::track_t& msg) {
   t.yaw_rate = msg.yaw_rate;
   t.rear_axle_offset = msg.rear_axle_offset;
   t.num_hypotheses = msg.num_hypotheses;
+  t.vehicle_probability = msg.vehicle_probability;
   const std::size_t n = std::min(msg.pred_x.size(), msg.pred_y.size());
   t.predicted.reserve(n);
   for (std::size_t i = 0; i < n; ++i) t.predicted.emplace_back(msg.pred_x[i], msg.pred_y[i]);

@@ -410,9 +410,12 @@ int StateThickness(const SceneTrack& t) {
 std::string TrackLabel(const SceneTrack& t) {
   std::ostringstream os;
   os << '#' << t.id;
-  if (IsClutter(t)) return os.str();
+  // The vehicle probability beside the class: why a track is (not) drawn as a vehicle.
+  const std::string p =
+      std::isfinite(t.vehicle_probability) ? " p=" + FormatNumber(t.vehicle_probability, 2) : "";
+  if (IsClutter(t)) return os.str() + p;
   os << ' ' << ModelName(t.model) << ' ' << FormatNumber(t.speed, 1) << " m/s  "
-     << t.num_hypotheses << " hyp";
+     << t.num_hypotheses << " hyp" << p;
   if (t.status == TrackStatus::kTentative) os << " (new)";
   if (t.status == TrackStatus::kCoasting) os << " (coast)";
   return os.str();

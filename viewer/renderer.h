@@ -14,7 +14,8 @@
 //   updated state and its position covariance  orange rectangle and ellipse (Eq. 19)
 //   estimated rear axle (VASM's L)             dashed red line across the vehicle
 //   clutter tracks (class "other")             thin brown rectangle
-//   label: id, model, speed, hypothesis count  beside each track
+//   label: id, model, speed, hypothesis count, beside each track
+//          vehicle probability (p=)
 //   scale bar, time stamp, legend              corners of the frame
 // Tentative tracks are drawn thin, coasting tracks dashed. Ellipses are drawn at
 // RenderParams::ellipse_sigma standard deviations of the 2x2 position block.

@@ -44,6 +44,7 @@ struct SceneTrack {
   double yaw_rate = 0.0;                              // [rad/s]
   double rear_axle_offset = kNaN;                     // [m] VASM's L (< 0 behind); NaN for ISM
   int num_hypotheses = 1;                             // [-] live hypotheses of the object
+  double vehicle_probability = kNaN;                  // [-] from its vehicle evidence (track_t)
   std::vector<Eigen::Vector2d> past;                  // [m] recent centres, oldest first (blue)
   std::vector<Eigen::Vector2d> predicted;             // [m] predicted centres, nearest first (black)
 };

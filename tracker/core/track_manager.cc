@@ -469,6 +469,10 @@ void TrackManager::Report(std::int64_t utime, std::vector<TrackReport>* out) con
     }
     r.vehicle_probability = VehicleProbability(t.vehicle_log_odds);
     r.object_class = Classify(params_, evidence_, t, vehicle_needs_box_, utime, vehicle_box_score_);
+    if (r.object_class == ObjectClass::kVehicle && t.small_object) {
+      // A vehicle seen by a few returns (its evidence says so) is still a vehicle's size.
+      measurer_.Dimensions(false, sel, &r.length, &r.width);
+    }
     if (r.object_class != ObjectClass::kVehicle && sel.length_est && sel.width_est) {
       // Clutter: its own size, not the vehicle default.
       r.length = *sel.length_est;

@@ -11,7 +11,10 @@
 
 #include "tracker/core/preprocess.h"
 #include "tracker/core/scan.h"
+#include "tracker/core/ekf.h"
 #include "tracker/core/track.h"
+#include "tracker/core/track_manager.h"
+#include "tracker/core/tracker.h"
 
 namespace vtrack {
 namespace {
@@ -128,6 +131,46 @@ TEST(VehicleEvidence, TopRingIsTheHighestBeamWhicheverWayRingsAreNumbered) {
   flat.z = {0.0f};
   flat.ring = {0};
   EXPECT_EQ(TopRing(flat), -1);
+}
+
+}  // namespace
+}  // namespace vtrack
+
+namespace vtrack {
+namespace {
+
+// A small object (a few returns, measured by its centroid) that its evidence classes a vehicle is
+// reported at a vehicle's size, never as a 0.5 m object.
+TEST(VehicleEvidence, ASmallObjectClassedVehicleIsReportedAtAVehiclesSize) {
+  TrackerParams p;
+  p.evidence.classifier_3d = VehicleClassifier::kEvidence;
+  p.evidence.bias_3d = 8.0;  // every scan says "vehicle"
+  p.evidence.terms_3d.clear();
+  const Ekf ekf(p.ism, p.vasm, p.ekf, p.cv);
+  TrackManager manager(p.manager, ekf, p.fit, p.shape);
+  manager.SetEvidence(p.evidence);
+  PointSet pts;
+  pts.origin = Eigen::Vector2d(10.0, 5.0);
+  for (int i = 0; i < 6; ++i) {  // 0.5 m across
+    pts.x.push_back(0.1f * static_cast<float>(i));
+    pts.y.push_back(0.05f * static_cast<float>(i % 2));
+  }
+  pts.extent = std::hypot(0.5, 0.05);
+  pts.mean_utime = 1'000'000;
+  ASSERT_TRUE(manager.Create(pts, Eigen::Vector2d::Zero(), 1));
+  ASSERT_TRUE(manager.tracks()[0].small_object);
+  ReturnEvidence r;
+  r.three_d = true;
+  r.num_points = 6;
+  r.range = 11.0;
+  for (int k = 0; k < 5; ++k) manager.ObserveEvidence(0, r);
+  std::vector<TrackReport> out;
+  manager.Report(1'000'000, &out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].object_class, ObjectClass::kVehicle);
+  EXPECT_GT(out[0].vehicle_probability, 0.99);
+  EXPECT_GE(out[0].length, p.manager.default_length) << out[0].length << ' ' << out[0].width;
+  EXPECT_GE(out[0].width, p.manager.default_width);
 }
 
 }  // namespace

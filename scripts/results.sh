@@ -296,7 +296,8 @@ $(compare_table "$work/boxes.json")
 ### The KITTI 3-D criterion, summed over the sequences
 
 The same tracks in the KITTI result format (\`vtrack-eval --kitti-out\`, the track score as the
-score column), scored by \`vtrack-eval-kitti\` inside the same run: class car, 3-D IoU >= 0.25,
+score column; confirmed tracks, tentative ones in the frames a box measured them, and one
+coasting frame after a miss: log_tools/README.md), scored by \`vtrack-eval-kitti\` inside the same run: class car, 3-D IoU >= 0.25,
 the devkit's rules and AB3DMOT's score-threshold sweep over 40 recall points (percentages).
 Prediction errors: \`vtrack-eval\`'s, over the sequences' matches (CLEAR MOT gate 2 m), all of
 them, and split by the truth's own motion over the horizon: turning when its heading changes by

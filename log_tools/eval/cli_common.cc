@@ -47,6 +47,12 @@ void AddEvalOptions(po::options_description* desc, EvalCliOptions* o) {
      "[m] LADAR height above the road (bottom of exported boxes of tracks without track_t.z)")
     ("kitti-box-height", po::value(&o->kitti_box_height_m)->default_value(o->kitti_box_height_m, "1.6"),
      "[m] box height written for exported tracks without track_t.height (scans only)")
+    ("kitti-tentative", po::value(&o->kitti_tentative)->default_value(o->kitti_tentative),
+     "--kitti-out: also write tentative tracks in the frames a detector's box measured them "
+     "(0 = confirmed tracks only)")
+    ("kitti-coast-frames", po::value(&o->kitti_coast_frames)->default_value(o->kitti_coast_frames),
+     "--kitti-out: write a coasting track for this many frames after the last that measured it "
+     "(--score-coasting: all)")
     ("kitti-time-offset", po::value(&o->kitti_time_offset_s)->default_value(o->kitti_time_offset_s),
      "[s] advance of exported states (scan time -> label time); < 0 = half the sweep duration");
 }
@@ -137,6 +143,8 @@ std::optional<KittiExportParams> MakeKittiExportParams(const EvalCliOptions& o) 
   k.box_height_m = o.kitti_box_height_m;
   k.time_offset_s = o.kitti_time_offset_s;
   k.score_coasting = o.score_coasting;
+  k.tentative_boxes = o.kitti_tentative;
+  k.coast_frames = o.kitti_coast_frames;
   if (const std::string err = k.Validate(); !err.empty()) {
     throw std::invalid_argument("bad KITTI export option: " + err);
   }

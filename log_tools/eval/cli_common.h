@@ -34,6 +34,8 @@ struct EvalCliOptions {
   double kitti_sensor_height_m = 1.73;
   double kitti_box_height_m = 1.6;
   double kitti_time_offset_s = -1.0;
+  bool kitti_tentative = true;
+  int kitti_coast_frames = 1;
 };
 
 // Adds the evaluation options (gate, region, horizons, channels, KITTI calibration) to desc.

@@ -400,9 +400,13 @@ int RunCompare(const CompareOptions& o) {
           // The tracks in the KITTI result format, for the 3-D IoU criterion (vtrack-eval-kitti).
           const fs::path kdir = fs::path(work) / ("kitti_results_" + mode);
           fs::create_directories(kdir);
-          RunProcess({tool("vtrack-eval"), run, tracks, "--mode", mode, "--kitti-calib",
-                      FindKittiCalib(o, item), "--kitti-out", (kdir / (item.sequence + ".txt")).string()},
-                     (dir / ("kitti_export_" + mode + ".log")).string(), o.timeout_s);
+          std::vector<std::string> export_argv = {
+              tool("vtrack-eval"), run, tracks, "--mode", mode, "--kitti-calib",
+              FindKittiCalib(o, item), "--kitti-out", (kdir / (item.sequence + ".txt")).string(),
+              "--kitti-tentative", o.eval.kitti_tentative ? "1" : "0", "--kitti-coast-frames",
+              std::to_string(o.eval.kitti_coast_frames)};
+          if (o.eval.score_coasting) export_argv.push_back("--score-coasting");
+          RunProcess(export_argv, (dir / ("kitti_export_" + mode + ".log")).string(), o.timeout_s);
         }
       } catch (const std::exception& e) {
         failures.push_back(item.name + " / " + mode + ": " + e.what());

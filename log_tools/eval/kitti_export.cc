@@ -7,6 +7,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <unordered_map>
 
 #include "log_tools/eval/report.h"
 #include "base/angle.h"
@@ -21,6 +22,8 @@ std::string KittiExportParams::Validate() const {
     os << "sensor_height_m must be > 0, got " << sensor_height_m;
   } else if (!(box_height_m > 0.0 && std::isfinite(box_height_m))) {
     os << "box_height_m must be > 0, got " << box_height_m;
+  } else if (coast_frames < 0) {
+    os << "coast_frames must be >= 0, got " << coast_frames;
   } else if (!std::isfinite(time_offset_s)) {
     os << "time_offset_s must be finite, got " << time_offset_s;
   } else if (!P2.allFinite() || P2.row(2).head<3>().norm() == 0.0) {
@@ -54,25 +57,43 @@ KittiExportStats ExportKittiTracking(const LogData& data, const std::string& mod
     std::string text;
   };
   std::vector<Line> lines;
+  // Per track id: the frame and the update count of the last list that measured it (a tentative
+  // track keeps its status over a miss, so a new measurement shows as a larger num_updates).
+  struct Seen {
+    std::int64_t frame = 0;
+    std::int32_t updates = 0;
+  };
+  std::unordered_map<std::int64_t, Seen> measured;
   std::int64_t index = 0;
   for (const auto& [utime, list] : lists->second) {
     ++stats.frames;
     const std::int64_t frame = list.scan_seq >= 0 ? list.scan_seq : index;
     ++index;
     const auto ego = data.poses.At(utime + offset_us, 500'000);
-    if (!ego) {
-      ++stats.frames_without_pose;
-      continue;
-    }
-    const Eigen::Isometry3d sensor_from_world = (*ego * body_from_sensor).inverse();
+    if (!ego) ++stats.frames_without_pose;  // its tracks still count as measured below
+    const Eigen::Isometry3d sensor_from_world =
+        ego ? Eigen::Isometry3d((*ego * body_from_sensor).inverse()) : Eigen::Isometry3d::Identity();
     for (const auto& tr : list.tracks) {
-      const bool status_ok = tr.status == vtrack::track_t::STATUS_CONFIRMED ||
-                             (params.score_coasting && tr.status == vtrack::track_t::STATUS_COASTING);
       // Vehicles, and every track a detector's box measured (height finite) whatever its class:
       // the tracker calls a box track a vehicle only from a confident score, while the KITTI
       // criterion sweeps the score threshold itself (sAMOTA), so the weak ones go out ranked by it.
       const bool box_measured = std::isfinite(tr.height);
-      if (!status_ok || (tr.object_class != vtrack::track_t::CLASS_VEHICLE && !box_measured)) continue;
+      const auto seen = measured.find(tr.id);
+      const bool coasting = tr.status == vtrack::track_t::STATUS_COASTING;
+      const bool measured_now = !coasting && (seen == measured.end() || tr.num_updates > seen->second.updates);
+      if (measured_now) measured[tr.id] = {frame, tr.num_updates};
+      bool write = false;
+      if (tr.status == vtrack::track_t::STATUS_CONFIRMED) {
+        write = true;
+      } else if (tr.status == vtrack::track_t::STATUS_TENTATIVE) {
+        write = params.tentative_boxes && box_measured && measured_now;
+      } else if (coasting) {
+        write = params.score_coasting ||
+                (seen != measured.end() && frame - seen->second.frame <= params.coast_frames);
+      }
+      if (!ego || !write || (tr.object_class != vtrack::track_t::CLASS_VEHICLE && !box_measured)) {
+        continue;
+      }
       const double dt = stats.time_offset_s;
       const double speed = std::isfinite(tr.speed) ? tr.speed : 0.0;
       const double vh = std::isfinite(tr.velocity_heading) ? tr.velocity_heading : tr.theta;

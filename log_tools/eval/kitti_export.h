@@ -17,7 +17,11 @@
 //    behind the camera or a box outside the image is not written;
 //  - score: the track's score (track_t.score: from a detector's boxes, the recency-weighted mean
 //    of their scores; from scans, n / (n + confirm_updates)), which ranks the tracks for the
-//    score-threshold sweep of sAMOTA; only confirmed vehicle tracks are written.
+//    score-threshold sweep of sAMOTA;
+//  - which tracks: confirmed vehicles and confirmed tracks a detector's box measured (a box track
+//    is a vehicle only from a confident score, while the criterion sweeps the score itself);
+//    tentative box tracks in the frames a box measured them (tentative_boxes); coasting ones for
+//    coast_frames frames after their last measured frame (all of them with score_coasting).
 #pragma once
 
 #include <Eigen/Geometry>
@@ -37,7 +41,13 @@ struct KittiExportParams {
   double sensor_height_m = 1.73;    // [m] LADAR above the road (KITTI's Velodyne); > 0
   double box_height_m = 1.6;        // [m] height written for tracks without one (scans); > 0
   double time_offset_s = -1.0;      // [s] state advance; < 0 = half the log's sweep duration
-  bool score_coasting = false;      // [-] also write coasting tracks
+  bool score_coasting = false;      // [-] also write coasting tracks, every frame they coast
+  // [-] also write a tentative track in the frames a detector's box measured it: the criterion
+  // ranks tracks by score, so a track from a confident first box need not wait for confirmation.
+  bool tentative_boxes = true;
+  // [frames] >= 0: write a coasting track for this many frames after the last that measured it
+  // (its state predicted), as AB3DMOT does for one; longer gaps are left out.
+  int coast_frames = 1;
   std::string Validate() const;     // "" if valid, else names the key and the value
 };
 

@@ -8,7 +8,11 @@
 #include <cmath>
 #include <fstream>
 #include <numbers>
+#include <limits>
+#include <set>
 #include <sstream>
+#include <tuple>
+#include <vector>
 
 #include "lcmtypes/util/decode.h"
 #include "lcmtypes/util/log_reader.h"
@@ -256,6 +260,111 @@ TEST_F(EvalCliTest, KittiExportTakesATracksBottomAndHeightFromItsBoxes) {
   EXPECT_EQ(b_lines, kScans);
   EXPECT_GT(other_lines, 0);
   EXPECT_GT(boxed_other_lines, 0);  // a box track of low score: its class other, still exported
+}
+
+
+// Which tracks the KITTI export writes, by status: track 2 (in the camera's view) rewritten as a
+// box track (height finite) whose status and update count follow a script, and track 8, a copy
+// measured by scans only (no height) and tentative throughout. Expected frames counted by hand.
+TEST_F(EvalCliTest, KittiExportWritesTentativeBoxTracksAndAShortCoast) {
+  const std::string calib = dir_ + "/calib_s.txt";
+  {
+    std::ofstream c(calib);
+    const char* p = "500 0 600 0 0 500 180 0 0 0 1 0";
+    c << "P0: " << p << "\nP1: " << p << "\nP2: " << p << "\nP3: " << p << "\n"
+      << "R0_rect: 1 0 0 0 1 0 0 0 1\n"
+      << "Tr_velo_to_cam: 0 -1 0 0 0 0 -1 0 1 0 0 0\n"
+      << "Tr_imu_to_velo: 1 0 0 0 0 1 0 0 0 0 1 0\n";
+  }
+  // Frame k: status and num_updates of track 2.
+  //   0, 1: tentative, 1 and 2 updates (measured); 2: tentative, still 2 (missed); 3: tentative, 3;
+  //   4-9: confirmed, 4-9; 10-13: coasting, 9; 14 on: confirmed, 10 on.
+  const auto script = [](int k) -> std::pair<std::int8_t, std::int32_t> {
+    using T = vtrack::track_t;
+    if (k <= 1) return {T::STATUS_TENTATIVE, k + 1};
+    if (k == 2) return {T::STATUS_TENTATIVE, 2};
+    if (k == 3) return {T::STATUS_TENTATIVE, 3};
+    if (k <= 9) return {T::STATUS_CONFIRMED, k};
+    if (k <= 13) return {T::STATUS_COASTING, 9};
+    return {T::STATUS_CONFIRMED, k - 4};
+  };
+  const std::string tracks_s = dir_ + "/tracks_s.lcm";
+  {
+    lcm_util::LogReader in(tracks_);
+    lcm_util::LogWriter w(tracks_s);
+    int k = 0;
+    while (const lcm::LogEvent* ev = in.Next()) {
+      if (ev->channel != "TRACKS") {
+        w.Write(ev->timestamp, ev->channel, ev->data, static_cast<std::size_t>(ev->datalen));
+        continue;
+      }
+      vtrack::track_list_t m;
+      ASSERT_EQ(lcm_util::Decode(ev->data, static_cast<std::size_t>(ev->datalen), &m),
+                lcm_util::DecodeError::kNone);
+      std::vector<vtrack::track_t> kept;
+      for (auto t : m.tracks) {
+        if (t.id != 2) continue;
+        t.z = -1.2;
+        t.height = 1.9;
+        std::tie(t.status, t.num_updates) = script(k);
+        kept.push_back(t);
+        vtrack::track_t scan_only = t;
+        scan_only.id = 8;
+        scan_only.status = vtrack::track_t::STATUS_TENTATIVE;
+        scan_only.z = scan_only.height = std::numeric_limits<double>::quiet_NaN();
+        scan_only.num_updates = k + 1;
+        kept.push_back(scan_only);
+      }
+      m.tracks = kept;
+      m.num_tracks = static_cast<std::int32_t>(kept.size());
+      w.WriteMessage(ev->timestamp, "TRACKS", m);
+      ++k;
+    }
+  }
+  const auto frames_written = [&](const std::vector<std::string>& extra) {
+    const std::string out_file = dir_ + "/kitti_s.txt";
+    std::vector<std::string> args = {run_, tracks_s, "--kitti-calib", calib, "--kitti-out", out_file,
+                                     "--kitti-image-size", "1200x360"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    std::string out;
+    EXPECT_EQ(RunTool(args, &out), 0) << out;
+    std::set<long long> frames;
+    std::ifstream in(out_file);
+    for (std::string l; std::getline(in, l);) {
+      std::istringstream ss(l);
+      long long frame = 0, id = 0;
+      ss >> frame >> id;
+      EXPECT_EQ(id, 2) << l;  // never the scan-only tentative track
+      frames.insert(frame);
+    }
+    return frames;
+  };
+  const auto range = [](int a, int b) {
+    std::set<long long> s;
+    for (int k = a; k <= b; ++k) s.insert(k);
+    return s;
+  };
+  std::set<long long> expected = {0, 1, 3};  // defaults: tentative box frames, one coasting frame
+  for (const long long f : range(4, 10)) expected.insert(f);
+  for (const long long f : range(14, kScans - 1)) expected.insert(f);
+  EXPECT_EQ(frames_written({}), expected);
+
+  std::set<long long> confirmed = range(4, 9);  // confirmed only
+  for (const long long f : range(14, kScans - 1)) confirmed.insert(f);
+  EXPECT_EQ(frames_written({"--kitti-tentative", "0", "--kitti-coast-frames", "0"}), confirmed);
+
+  std::set<long long> coast3 = confirmed;  // three coasting frames, no tentative ones
+  for (const long long f : range(10, 12)) coast3.insert(f);
+  EXPECT_EQ(frames_written({"--kitti-tentative", "0", "--kitti-coast-frames", "3"}), coast3);
+
+  std::set<long long> all_coast = confirmed;  // --score-coasting: every coasting frame
+  for (const long long f : range(10, 13)) all_coast.insert(f);
+  EXPECT_EQ(frames_written({"--kitti-tentative", "0", "--score-coasting"}), all_coast);
+
+  std::string out;
+  EXPECT_EQ(RunTool({run_, tracks_s, "--kitti-calib", calib, "--kitti-out", dir_ + "/x.txt",
+                     "--kitti-coast-frames", "-1"}, &out), 2);
+  EXPECT_NE(out.find("coast_frames must be >= 0, got -1"), std::string::npos) << out;
 }
 
 }  // namespace

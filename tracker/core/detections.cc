@@ -67,8 +67,13 @@ BoxAssociation AssociateBoxes(const std::vector<PredictedObject>& tracks,
   out.track_box.assign(tracks.size(), -1);
   std::vector<char> taken(boxes.size(), 0);
   if (rows > 0 && nb > 0) {
-    // Columns: the boxes, then one "no box" column per track at the gate's cost.
+    // Columns: the boxes, then one "no box" column per track. Its cost is the same for every
+    // track, the largest gate: a track's own gate there would let an uncertain track (a wide
+    // gate, so much to lose without a box) outbid a well-known one for a box nearer to the
+    // latter. At the largest gate every gated pair is worth taking, and among the assignments
+    // of most pairs the one of least summed distance wins.
     const int cols = nb + rows;
+    const double no_box_cost = params.max_gate_m;
     std::vector<double> cost(static_cast<std::size_t>(rows) * cols, kForbidden);
     for (int r = 0; r < rows; ++r) {
       const PredictedObject& t = tracks[static_cast<std::size_t>(r)];
@@ -78,7 +83,7 @@ BoxAssociation AssociateBoxes(const std::vector<PredictedObject>& tracks,
         const double d = (boxes[static_cast<std::size_t>(k)].box.center - t.box.center).norm();
         if (d <= gate) cost[static_cast<std::size_t>(r) * cols + k] = d;
       }
-      cost[static_cast<std::size_t>(r) * cols + nb + r] = gate;
+      cost[static_cast<std::size_t>(r) * cols + nb + r] = no_box_cost;
     }
     const std::vector<int> assign = SolveAssignment(cost, rows, cols);
     for (int r = 0; r < rows; ++r) {

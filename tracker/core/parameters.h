@@ -546,7 +546,7 @@ struct DetectionParams {
     v("heading_std_deg", &heading_std_deg, {"deg", OpenClosed(0, 90), "1-sigma of a box heading (modulo 180 deg)"});
     v("gate_m", &gate_m, {"m", Above(0), "a box farther than this (+ gate_sigma predicted position stds) from a track is not its candidate"});
     v("gate_sigma", &gate_sigma, {"-", AtLeast(0), "predicted position stds added to gate_m"});
-    v("max_gate_m", &max_gate_m, {"m", OpenClosed(0, 50), "upper bound of the whole gate (>= gate_m)"});
+    v("max_gate_m", &max_gate_m, {"m", OpenClosed(0, 50), "upper bound of the whole gate (>= gate_m), and the cost of a track going without a box in the association"});
     v("fused_vehicle_needs_box", &fused_vehicle_needs_box, {"-", {}, "fused: a track is a vehicle only while its boxes would confirm it (manager.confirm_updates boxes, the latest within manager.coast_max_s); scan-only tracks are other: the size rules alone class walls and hedges as cars"});
     v("score_memory", &score_memory, {"-", Closed(1, 1000), "a track's score: mean of its boxes' scores, each update weighted 1/min(n, this) (recent boxes count more; 10: about 1 s at 10 Hz)"});
   }

@@ -473,8 +473,11 @@ void TrackManager::Report(std::int64_t utime, std::vector<TrackReport>* out) con
       // A vehicle seen by a few returns (its evidence says so) is still a vehicle's size.
       measurer_.Dimensions(false, sel, &r.length, &r.width);
     }
-    if (r.object_class != ObjectClass::kVehicle && sel.length_est && sel.width_est) {
-      // Clutter: its own size, not the vehicle default.
+    if ((r.object_class != ObjectClass::kVehicle || t.box_updates > 0) && sel.length_est &&
+        sel.width_est) {
+      // Clutter: its own size, not the vehicle default. A track a detector's box measured: its
+      // size from the boxes, each a full view (a car shorter than default_length is not
+      // lengthened to it).
       r.length = *sel.length_est;
       r.width = *sel.width_est;
     }

@@ -62,6 +62,29 @@ TEST(AssociateBoxes, PairsOneToOneByDistanceWithinTheGate) {
   EXPECT_EQ(a.new_boxes, std::vector<int>{2});
 }
 
+// One box between a well-known track 0.7 m away (gate 2 + 3 * 0.1 = 2.3 m) and an uncertain
+// one 1.6 m away (gate 2 + 3 * 1.0 = 5 m): the nearer, well-known track takes it. (With a
+// track's own gate as its cost of going without a box, the uncertain one would: 0.7 + 5 > 1.6
+// + 2.3.)
+TEST(AssociateBoxes, AnUncertainTrackDoesNotOutbidANearerOne) {
+  std::vector<PredictedObject> tracks(2);
+  tracks[0].box.center = {0.0, 0.0};
+  tracks[0].position_std = 0.1;
+  tracks[1].box.center = {2.3, 0.0};
+  tracks[1].position_std = 1.0;
+  std::vector<BoxMeasurement> boxes(1);
+  boxes[0].box.center = {0.7, 0.0};
+  DetectionParams p;
+  p.gate_m = 2.0;
+  p.gate_sigma = 3.0;
+  p.max_gate_m = 5.0;
+  const BoxAssociation a = AssociateBoxes(tracks, boxes, p);
+  ASSERT_EQ(a.track_box.size(), 2u);
+  EXPECT_EQ(a.track_box[0], 0);
+  EXPECT_EQ(a.track_box[1], -1);
+  EXPECT_TRUE(a.new_boxes.empty());
+}
+
 TEST(BoxesInWorld, PlacesBoxesWithTheEgoPoseAndDropsWeakOnes) {
   DetectionList list;
   list.utime = kT0;
@@ -144,6 +167,50 @@ TEST(TrackerBoxes, FollowsACarWhoseBoxesAreNoisyAndOftenTurnedAround) {
   EXPECT_EQ(ids.size(), 1u);
   EXPECT_EQ(frames_checked, 21);
   EXPECT_EQ(tracker.rejects().count("bad_detections"), 0u);
+}
+
+// A car shorter and narrower than the default rectangle (4.5 x 1.8 m): its boxes, each a full
+// view, give its size; it is not lengthened to the default.
+TEST(TrackerBoxes, ReportsTheSizeOfTheBoxesNotTheDefaultRectangle) {
+  TrackerParams params;
+  params.detections.mode = InputMode::kBoxes;
+  ASSERT_GT(params.manager.default_length, 4.0);
+  ASSERT_GT(params.manager.default_width, 1.7);
+  Tracker tracker(params);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.1);
+  constexpr double kLength = 3.6, kWidth = 1.55;  // [m]
+  std::vector<ScanOutput> out;
+  int checked = 0;
+  for (int k = 0; k <= 30; ++k) {
+    const std::int64_t t = kT0 + k * 100'000;
+    tracker.AddPose({t, Eigen::Isometry3d::Identity()}, &out);
+    DetectionList list;
+    list.utime = t;
+    list.seq = k;
+    Detection d;
+    d.x = 12.0 + noise(rng);
+    d.y = 4.0 + noise(rng);
+    d.yaw = 0.4;
+    d.length = kLength + noise(rng);
+    d.width = kWidth + noise(rng);
+    d.height = 1.5;
+    d.score = 6.0;
+    list.boxes.push_back(d);
+    out.clear();
+    tracker.AddDetections(std::move(list), &out);
+    tracker.AddPose({t + 50'000, Eigen::Isometry3d::Identity()}, &out);
+    for (const ScanOutput& o : out) {
+      for (const TrackReport& r : o.tracks) {
+        if (k < 10 || r.status != TrackStatus::kConfirmed) continue;
+        ++checked;
+        EXPECT_NEAR(r.length, kLength, 0.25) << "frame " << k;
+        EXPECT_NEAR(r.width, kWidth, 0.25) << "frame " << k;
+        EXPECT_EQ(r.object_class, ObjectClass::kVehicle);
+      }
+    }
+  }
+  EXPECT_EQ(checked, 21);
 }
 
 // Two cars side by side whose boxes come with seeded random scores, one car's higher on the

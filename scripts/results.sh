@@ -253,7 +253,8 @@ WORK below is the script's work directory (\`--work-dir\`). What each metric mea
 ## Tracking accuracy, three modes side by side
 
 \`vtrack-eval\` scoring: confirmed tracks classed vehicle, CLEAR MOT gate 2 m, all ranges; KITTI:
-cars and vans within 40 m in camera 2's view. Simulator seed $seed.
+cars and vans within 40 m in camera 2's view, unmatched tracks in DontCare regions not counted
+(as the KITTI devkit; log_tools/README.md). Simulator seed $seed.
 
 \`\`\`sh
 $compare_cmd

@@ -41,6 +41,10 @@ void AddEvalOptions(po::options_description* desc, EvalCliOptions* o) {
      "LADAR slice channel (the same, for sweeps sent as slices)")
     ("kitti-calib", po::value(&o->kitti_calib), "KITTI calibration file (calib/NNNN.txt) for "
                                                 "--region-camera and --kitti-out")
+    ("kitti-dontcare", po::value(&o->kitti_dont_care),
+     "KITTI label file (label_02/NNNN.txt): an unmatched track whose image box lies more than "
+     "half in one of its DontCare regions is not a false positive, as in the KITTI devkit "
+     "(needs --region-camera)")
     ("kitti-image-size", po::value(&o->kitti_image_size)->default_value(o->kitti_image_size),
      "[px] camera 2 image size WxH")
     ("kitti-sensor-height", po::value(&o->kitti_sensor_height_m)->default_value(o->kitti_sensor_height_m),
@@ -89,6 +93,16 @@ kitti::Calibration ReadCalib(const std::string& path) {
   }
 }
 
+ImageProjection MakeImageProjection(const EvalCliOptions& o, const kitti::Calibration& calib) {
+  ImageProjection cam;
+  cam.rect_from_sensor = calib.RectFromVelo();
+  cam.P = *calib.P[2];
+  std::tie(cam.image_width, cam.image_height) = ParseImageSize(o.kitti_image_size);
+  cam.sensor_height_m = o.kitti_sensor_height_m;
+  cam.box_height_m = o.kitti_box_height_m;
+  return cam;
+}
+
 }  // namespace
 
 EvalParams MakeEvalParams(const EvalCliOptions& o) {
@@ -125,6 +139,23 @@ EvalParams MakeEvalParams(const EvalCliOptions& o) {
     cam.P = *calib.P[2];
     cam.width = ParseImageSize(o.kitti_image_size).first;
     p.region_camera = cam;
+    if (!o.kitti_dont_care.empty()) {
+      DontCareRegions dc;
+      dc.camera = MakeImageProjection(o, calib);
+      std::vector<kitti::Label> labels;
+      try {
+        labels = kitti::ReadLabels(o.kitti_dont_care);
+      } catch (const kitti::KittiError& e) {
+        throw std::invalid_argument(std::string("--kitti-dontcare: ") + e.what());
+      }
+      for (const kitti::Label& l : labels) {
+        if (!l.IsDontCare()) continue;
+        dc.boxes[l.frame].push_back({l.bbox(0), l.bbox(1), l.bbox(2), l.bbox(3)});
+      }
+      p.dont_care = std::move(dc);
+    }
+  } else if (!o.kitti_dont_care.empty()) {
+    throw std::invalid_argument("--kitti-dontcare needs --region-camera");
   }
   if (const std::string err = p.Validate(); !err.empty()) {
     throw std::invalid_argument("bad evaluation option: " + err);
@@ -136,11 +167,7 @@ std::optional<KittiExportParams> MakeKittiExportParams(const EvalCliOptions& o) 
   if (o.kitti_calib.empty()) return std::nullopt;
   const kitti::Calibration calib = ReadCalib(o.kitti_calib);
   KittiExportParams k;
-  k.rect_from_sensor = calib.RectFromVelo();
-  k.P2 = *calib.P[2];
-  std::tie(k.image_width, k.image_height) = ParseImageSize(o.kitti_image_size);
-  k.sensor_height_m = o.kitti_sensor_height_m;
-  k.box_height_m = o.kitti_box_height_m;
+  k.camera = MakeImageProjection(o, calib);
   k.time_offset_s = o.kitti_time_offset_s;
   k.score_coasting = o.score_coasting;
   k.tentative_boxes = o.kitti_tentative;

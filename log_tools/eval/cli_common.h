@@ -30,6 +30,7 @@ struct EvalCliOptions {
   std::string scan_channel = "LADAR_SCAN";
   std::string slice_channel = "LADAR_SLICE";
   std::string kitti_calib;
+  std::string kitti_dont_care;      // KITTI label file whose DontCare rows are not scored
   std::string kitti_image_size = "1242x375";
   double kitti_sensor_height_m = 1.73;
   double kitti_box_height_m = 1.6;

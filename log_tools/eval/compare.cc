@@ -125,6 +125,17 @@ std::string FindKittiCalib(const CompareOptions& o, const CompareItem& item) {
                            "' (needed to score KITTI inside the camera view): pass --kitti-calib");
 }
 
+// The sequence's label file, for its DontCare regions ("" if there is none: then none apply).
+std::string FindKittiLabels(const CompareOptions& o, const CompareItem& item) {
+  const std::string seq = kitti::NormaliseSequence(
+      item.kind == CompareItem::Kind::kKittiBoxes ? item.sequence : o.kitti_sequence);
+  for (const fs::path& p : {fs::path(item.source) / "label_02" / (seq + ".txt"),
+                            fs::path(item.source) / "training" / "label_02" / (seq + ".txt")}) {
+    if (fs::is_regular_file(p)) return p.string();
+  }
+  return "";
+}
+
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
@@ -329,6 +340,7 @@ int RunCompare(const CompareOptions& o) {
         kopt.kitti_calib = FindKittiCalib(o, item);
         kopt.region_camera = true;
         kopt.region_range_m = o.kitti_range_m;
+        if (o.kitti_dont_care) kopt.kitti_dont_care = FindKittiLabels(o, item);
         // With scans, the labels are half a sweep after the scan's utime.
         if (!boxes_only) kopt.truth_time_offset = "half-sweep";
         params = MakeEvalParams(kopt);
@@ -339,6 +351,7 @@ int RunCompare(const CompareOptions& o) {
         kopt.kitti_calib = FindKittiCalib(o, item);
         kopt.region_camera = true;
         kopt.region_range_m = o.kitti_range_m;
+        if (o.kitti_dont_care) kopt.kitti_dont_care = FindKittiLabels(o, item);
         params = MakeEvalParams(kopt);  // no scans: the truth and the boxes share the frame's time
       }
       if (o.reuse && fs::is_regular_file(run)) {

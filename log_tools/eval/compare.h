@@ -8,7 +8,9 @@
 //                  sum over the sequences is a row of its own (CLEAR MOT counts summed)
 // then for each mode M:  vtrack-tracker --input run.lcm --output tracks_M.lcm --mode M [--config F]
 // and the tracks are scored with vtrack_eval (a library call, the same code as vtrack-eval).
-// KITTI items are scored inside camera 2's view (its labelled region) within kitti_range_m.
+// KITTI items are scored inside camera 2's view (its labelled region) within kitti_range_m; an
+// unmatched track in one of the labels' DontCare regions is not a false positive (the KITTI
+// devkit's rule; kitti_dont_care false scores it as one).
 #pragma once
 
 #include <cstdint>
@@ -45,6 +47,7 @@ struct CompareOptions {
   std::string kitti_sequence = "0000";
   std::string kitti_poses, kitti_oxts, kitti_calib;  // [-] "" = the converter's / DIR's default
   double kitti_range_m = 40.0;        // [m] KITTI scoring range; > 0
+  bool kitti_dont_care = true;        // [-] KITTI: tracks in the labels' DontCare regions are not FP
   double kitti_iou = 0.25;            // [-] --kitti-boxes: 3-D IoU threshold of vtrack-eval-kitti
   EvalCliOptions eval;                // scoring options for the scenarios
   bool quiet = false;

@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   std::string scenarios, modes = "ism,vasm,mht";
   std::vector<std::string> kitti_dirs;
   std::string kitti_boxes_dir, sequences, kitti_input_modes = "scans";
+  bool no_dont_care = false;
 
   po::options_description desc(
       "vtrack-compare --scenarios a,b [--kitti DIR] [options]\n"
@@ -58,6 +59,9 @@ int main(int argc, char** argv) {
     ("kitti-oxts", po::value(&o.kitti_oxts), "OXTS file for the converter (--oxts)")
     ("kitti-range", po::value(&o.kitti_range_m)->default_value(o.kitti_range_m),
      "[m] KITTI items are scored within this distance")
+    ("kitti-no-dontcare", po::bool_switch(&no_dont_care),
+     "count unmatched tracks in the labels' DontCare regions as false positives (by default "
+     "they are not, as in the KITTI devkit)")
     ("modes", po::value(&modes)->default_value(modes), "tracker modes, comma separated")
     ("seed", po::value(&o.seed)->default_value(o.seed), "simulator seed")
     ("json", po::value(&o.json_path), "write {scenario: {mode: summary}} here")
@@ -125,6 +129,7 @@ int main(int argc, char** argv) {
       }
     }
     o.modes = SplitList(modes);
+    o.kitti_dont_care = !no_dont_care;
     return RunCompare(o);
   } catch (const std::invalid_argument& e) {
     std::cerr << "vtrack-compare: " << e.what() << "\n";

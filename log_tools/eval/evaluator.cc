@@ -206,6 +206,15 @@ std::string EvalParams::Validate() const {
   if (os.tellp() == 0 && region_camera && region_camera->width <= 0) {
     os << "region_camera.width must be > 0, got " << region_camera->width;
   }
+  if (os.tellp() == 0 && dont_care) {
+    if (!region_camera) {
+      os << "dont_care needs region_camera (the ego pose and the sensor mounting)";
+    } else if (!(dont_care->min_overlap > 0.0 && dont_care->min_overlap <= 1.0)) {
+      os << "dont_care.min_overlap must be in (0, 1], got " << dont_care->min_overlap;
+    } else if (const std::string err = dont_care->camera.Validate(); !err.empty()) {
+      os << "dont_care.camera: " << err;
+    }
+  }
   if (os.tellp() == 0) {
     ClearMotParams c;
     c.gate_m = gate_m;
@@ -527,6 +536,25 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params,
       if (partner[j] < 0 && !in_region(tp.x, tp.y, std::nullopt)) {
         ++s.outside_region_track_detections;
         continue;
+      }
+      if (partner[j] < 0 && params.dont_care && ego) {
+        const auto regions = params.dont_care->boxes.find(list.scan_seq);
+        if (regions != params.dont_care->boxes.end()) {
+          const Eigen::Isometry3d sensor_from_world = (*ego * body_from_sensor).inverse();
+          const std::optional<ImageBox> image =
+              ProjectToImage(TrackBoxInSensor(*tr, tp.x, tp.y, tp.theta, sensor_from_world,
+                                              params.dont_care->camera),
+                             tr->length, tr->width, params.dont_care->camera);
+          const bool inside = image && std::any_of(regions->second.begin(), regions->second.end(),
+                                                   [&](const ImageBox& r) {
+                                                     return OverlapOfFirst(*image, r) >
+                                                            params.dont_care->min_overlap;
+                                                   });
+          if (inside) {
+            ++s.dont_care_track_detections;
+            continue;
+          }
+        }
       }
       kept.push_back(tr);
       kept_pose.push_back(tp);

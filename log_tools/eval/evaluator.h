@@ -13,8 +13,8 @@
 //  - tracks: status confirmed (and coasting if score_coasting) and class vehicle. Tracks of other
 //    objects (track_t.CLASS_OTHER, unknown) are neither scored nor false positives. A vehicle
 //    track that one global assignment (centre distance < gate_m) pairs with an ignored truth
-//    object is dropped, as is an unpaired track outside the scoring region: neither can be
-//    judged.
+//    object is dropped, as is an unpaired track outside the scoring region, or (KITTI) one in a
+//    DontCare region: none can be judged.
 // Metrics: CLEAR MOT and HOTA (clear_mot.h) on the scored sets; state errors on the CLEAR MOT
 // matches:
 //  - position: centre distance [m];
@@ -44,6 +44,7 @@
 #include <vector>
 
 #include "log_tools/eval/clear_mot.h"
+#include "log_tools/eval/image_box.h"
 #include "base/pose.h"
 #include "vtrack/object_list_t.hpp"
 #include "vtrack/track_list_t.hpp"
@@ -60,6 +61,17 @@ struct CameraRegion {
   double track_z_sensor_m = -1.0;   // [m] height of a track's centre in the sensor frame (tracks
                                     //     carry none); about mid-height of a car under a roof LADAR
   bool Contains(const Eigen::Vector3d& p_sensor) const;
+};
+
+// KITTI's DontCare regions: image boxes of camera 2 where KITTI left objects unlabelled (far,
+// hidden or crowded cars among them), by KITTI frame (track_list_t.scan_seq). As the KITTI
+// devkit does, a track paired with no truth object whose image box lies in one of them by more
+// than min_overlap of its own area is not a false positive: it is dropped (needs region_camera
+// for the ego pose and the sensor mounting).
+struct DontCareRegions {
+  ImageProjection camera;
+  std::map<std::int64_t, std::vector<ImageBox>> boxes;
+  double min_overlap = 0.5;         // [-] in (0, 1]
 };
 
 struct EvalParams {
@@ -86,6 +98,7 @@ struct EvalParams {
   double moving_speed_mps = 0.5;    // [m/s] truth faster than this counts as moving (L error); >= 0
   double max_pose_gap_s = 0.5;      // [s] ego pose extrapolated at most this far for the region
   std::optional<CameraRegion> region_camera;  // score only inside this camera's view (also)
+  std::optional<DontCareRegions> dont_care;    // KITTI's DontCare regions (above)
   // [s] the ground truth of a scan describes the objects at utime + this (KITTI logs: the labels
   // are half a sweep after the scan's utime, sensor_driver/kitti/kitti_sequence.h). Tracks are
   // advanced to that time at constant velocity and yaw rate before they are scored. NaN = half
@@ -169,6 +182,7 @@ struct EvalSummary {
   std::int64_t scored_tracks = 0;         // distinct track ids scored at least once
   std::int64_t ignored_track_detections = 0;  // dropped: paired with an ignored truth object
   std::int64_t outside_region_track_detections = 0;  // dropped: unpaired and outside the region
+  std::int64_t dont_care_track_detections = 0;  // dropped: unpaired and in a DontCare region
   double position_rmse_m = 0.0;
   double heading_rmse_deg = 0.0;
   double heading_flip_fraction = 0.0;

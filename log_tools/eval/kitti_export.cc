@@ -16,18 +16,12 @@ namespace vtrack::eval {
 
 std::string KittiExportParams::Validate() const {
   std::ostringstream os;
-  if (image_width <= 0 || image_height <= 0) {
-    os << "image size must be positive, got " << image_width << "x" << image_height;
-  } else if (!(sensor_height_m > 0.0 && std::isfinite(sensor_height_m))) {
-    os << "sensor_height_m must be > 0, got " << sensor_height_m;
-  } else if (!(box_height_m > 0.0 && std::isfinite(box_height_m))) {
-    os << "box_height_m must be > 0, got " << box_height_m;
+  if (const std::string err = camera.Validate(); !err.empty()) {
+    os << err;
   } else if (coast_frames < 0) {
     os << "coast_frames must be >= 0, got " << coast_frames;
   } else if (!std::isfinite(time_offset_s)) {
     os << "time_offset_s must be finite, got " << time_offset_s;
-  } else if (!P2.allFinite() || P2.row(2).head<3>().norm() == 0.0) {
-    os << "P2 is not a projection matrix";
   }
   return os.str();
 }
@@ -98,59 +92,23 @@ KittiExportStats ExportKittiTracking(const LogData& data, const std::string& mod
       const double speed = std::isfinite(tr.speed) ? tr.speed : 0.0;
       const double vh = std::isfinite(tr.velocity_heading) ? tr.velocity_heading : tr.theta;
       const double yaw_rate = std::isfinite(tr.yaw_rate) ? tr.yaw_rate : 0.0;
-      // A detector's boxes give the track its bottom and height; otherwise the road and the
-      // default height.
-      const bool has_z = std::isfinite(tr.z) && std::isfinite(tr.height) && tr.height > 0.0;
-      const double box_height = has_z ? tr.height : params.box_height_m;
-      const Eigen::Vector3d centre_w(tr.x + speed * std::cos(vh) * dt,
-                                     tr.y + speed * std::sin(vh) * dt, has_z ? tr.z : 0.0);
+      const double x = tr.x + speed * std::cos(vh) * dt, y = tr.y + speed * std::sin(vh) * dt;
       const double theta = tr.theta + yaw_rate * dt;
-      if (!centre_w.allFinite() || !std::isfinite(theta) || !(tr.length > 0.0) ||
+      if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(theta) || !(tr.length > 0.0) ||
           !(tr.width > 0.0)) {
         continue;
       }
-      // Box in the sensor frame: bottom centre on the road, axes in the sensor's xy plane.
-      Eigen::Vector3d c_s = sensor_from_world * centre_w;
-      if (!has_z) c_s.z() = -params.sensor_height_m;
-      Eigen::Vector3d h_s = sensor_from_world.linear() * Eigen::Vector3d(std::cos(theta), std::sin(theta), 0.0);
-      h_s.z() = 0.0;
-      h_s.normalize();
-      const Eigen::Vector3d n_s(-h_s.y(), h_s.x(), 0.0);
-      const Eigen::Vector3d up(0.0, 0.0, 1.0);
-
-      std::array<Eigen::Vector3d, 8> corners;
-      int k = 0;
-      for (const double a : {0.5, -0.5}) {
-        for (const double b : {0.5, -0.5}) {
-          for (const double z : {0.0, box_height}) {
-            corners[k++] = c_s + a * tr.length * h_s + b * tr.width * n_s + z * up;
-          }
-        }
-      }
-      double u0 = std::numeric_limits<double>::infinity(), v0 = u0, u1 = -u0, v1 = -u0;
-      bool behind = false;
-      for (const auto& c : corners) {
-        const Eigen::Vector3d r = params.rect_from_sensor * c;
-        const Eigen::Vector3d img = params.P2 * r.homogeneous();
-        if (r.z() < 0.1 || img.z() <= 0.0) {
-          behind = true;
-          break;
-        }
-        u0 = std::min(u0, img.x() / img.z());
-        u1 = std::max(u1, img.x() / img.z());
-        v0 = std::min(v0, img.y() / img.z());
-        v1 = std::max(v1, img.y() / img.z());
-      }
-      u0 = std::max(u0, 0.0);
-      v0 = std::max(v0, 0.0);
-      u1 = std::min(u1, params.image_width - 1.0);
-      v1 = std::min(v1, params.image_height - 1.0);
-      if (behind || !(u1 > u0) || !(v1 > v0)) {
+      const SensorBox box = TrackBoxInSensor(tr, x, y, theta, sensor_from_world, params.camera);
+      const std::optional<ImageBox> image = ProjectToImage(box, tr.length, tr.width, params.camera);
+      if (!image) {
         ++stats.outside_image;
         continue;
       }
-      const Eigen::Vector3d bottom_r = params.rect_from_sensor * c_s;
-      const Eigen::Vector3d d_r = params.rect_from_sensor.linear() * h_s;
+      const Eigen::Vector3d c_s = box.bottom, h_s = box.heading;
+      const double box_height = box.height;
+      const double u0 = image->u0, v0 = image->v0, u1 = image->u1, v1 = image->v1;
+      const Eigen::Vector3d bottom_r = params.camera.rect_from_sensor * c_s;
+      const Eigen::Vector3d d_r = params.camera.rect_from_sensor.linear() * h_s;
       const double rotation_y = std::atan2(-d_r.z(), d_r.x());
       const double alpha = WrapToPi(rotation_y - std::atan2(bottom_r.x(), bottom_r.z()));
       char buf[512];

@@ -30,16 +30,12 @@
 #include <string>
 
 #include "log_tools/eval/evaluator.h"
+#include "log_tools/eval/image_box.h"
 
 namespace vtrack::eval {
 
 struct KittiExportParams {
-  Eigen::Affine3d rect_from_sensor = Eigen::Affine3d::Identity();  // from the calibration
-  Eigen::Matrix<double, 3, 4> P2 = Eigen::Matrix<double, 3, 4>::Zero();  // image 2 from rect [px]
-  int image_width = 1242;           // [px] > 0
-  int image_height = 375;           // [px] > 0
-  double sensor_height_m = 1.73;    // [m] LADAR above the road (KITTI's Velodyne); > 0
-  double box_height_m = 1.6;        // [m] height written for tracks without one (scans); > 0
+  ImageProjection camera;           // camera 2 (P2) from the calibration, image size, defaults
   double time_offset_s = -1.0;      // [s] state advance; < 0 = half the log's sweep duration
   bool score_coasting = false;      // [-] also write coasting tracks, every frame they coast
   // [-] also write a tentative track in the frames a detector's box measured it: the criterion

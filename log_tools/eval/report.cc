@@ -96,6 +96,10 @@ std::string SummaryText(const EvalSummary& s) {
   os << "  CLEAR MOT  MOTA " << Fixed(c.mota, 3) << "  MOTP " << Fixed(c.motp_m, 3) << " m  TP "
      << c.true_positives << "  FP " << c.false_positives << "  FN " << c.false_negatives
      << "  ID switches " << c.id_switches << "  fragmentations " << c.fragmentations << "\n";
+  if (s.dont_care_track_detections > 0) {
+    os << "             " << s.dont_care_track_detections
+       << " unmatched track detections in KITTI DontCare regions not counted as FP\n";
+  }
   os << "             mostly tracked " << c.mostly_tracked << "  partially " << c.partially_tracked
      << "  mostly lost " << c.mostly_lost << "\n";
   os << "  HOTA " << Fixed(s.hota.hota, 3) << "  DetA " << Fixed(s.hota.deta, 3) << "  AssA "
@@ -266,6 +270,7 @@ std::string SummaryJson(const EvalSummary& s) {
   w.Key("tracks_without_truth").Int(s.tracks_without_truth);
   w.Key("ignored_track_detections").Int(s.ignored_track_detections);
   w.Key("outside_region_track_detections").Int(s.outside_region_track_detections);
+  w.Key("dont_care_track_detections").Int(s.dont_care_track_detections);
   w.Key("problems").BeginObject();
   for (const auto& [k, v] : s.problems) w.Key(k).Int(v);
   w.EndObject();

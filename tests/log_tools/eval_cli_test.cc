@@ -51,6 +51,8 @@ TEST_F(EvalCliTest, HelpAndBadOptions) {
   EXPECT_NE(out.find("'x'"), std::string::npos) << out;
   EXPECT_EQ(RunTool({run_, "--region-camera"}, &out), 2);
   EXPECT_NE(out.find("--kitti-calib"), std::string::npos) << out;
+  EXPECT_EQ(RunTool({run_, "--kitti-dontcare", dir_ + "/labels.txt"}, &out), 2);
+  EXPECT_NE(out.find("--kitti-dontcare needs --region-camera"), std::string::npos) << out;
   EXPECT_EQ(RunTool({dir_ + "/missing.lcm"}, &out), 1);
   EXPECT_NE(out.find("missing.lcm"), std::string::npos) << out;
   EXPECT_EQ(RunTool({run_}, &out), 1);  // no tracks in it

@@ -147,6 +147,79 @@ TEST_F(EvaluatorTest, CameraRegion) {
   EXPECT_EQ(s.outside_region_track_detections, kScans);  // track 7 is behind the camera
 }
 
+// KITTI's DontCare rule: an unmatched track whose image box lies in a DontCare region by more
+// than half of its own area is not a false positive; a matched track is kept whatever regions
+// cover it. Camera: P = [500 0 600 0; 0 500 180 0; 0 0 1 0], rect from sensor the axis
+// permutation; ego and sensor at the origin (world = sensor). Track 99, a false vehicle at
+// (20, 0), theta 0, 4.5 x 1.8 m, no box z: bottom 1.73 m below the sensor, 1.6 m tall. Its
+// corners x in [17.75, 22.25], y in +-0.9, z in [-1.73, -0.13] project to
+// u = 600 - 500 y / x in [600 - 25.352, 600 + 25.352] and v = 180 - 500 z / x in
+// [180 + 500 * 0.13 / 22.25, 180 + 500 * 1.73 / 17.75] = [182.921, 228.732].
+TEST_F(EvaluatorTest, KittiDontCareRegionsDropUnmatchedTracksMostlyInside) {
+  CameraRegion cam;
+  Eigen::Matrix3d r;
+  r << 0, -1, 0, 0, 0, -1, 1, 0, 0;
+  cam.rect_from_sensor = Eigen::Affine3d::Identity();
+  cam.rect_from_sensor.linear() = r;
+  cam.P << 500, 0, 600, 0, 0, 500, 180, 0, 0, 0, 1, 0;
+  cam.width = 1200;
+  EvalParams params;
+  params.region_camera = cam;
+  LogData data = LoadLogs({run_, tracks_}, params);
+  for (auto& [utime, list] : data.tracks.at("mht")) {
+    vtrack::track_t fp = list.tracks.front();
+    fp.id = 99;
+    fp.status = vtrack::track_t::STATUS_CONFIRMED;
+    fp.object_class = vtrack::track_t::CLASS_VEHICLE;
+    fp.x = 20.0;
+    fp.y = 0.0;
+    fp.theta = 0.0;
+    fp.speed = fp.yaw_rate = 0.0;
+    fp.velocity_heading = 0.0;
+    fp.length = 4.5;
+    fp.width = 1.8;
+    fp.z = fp.height = std::numeric_limits<double>::quiet_NaN();
+    list.tracks.push_back(fp);
+    list.num_tracks = static_cast<std::int32_t>(list.tracks.size());
+  }
+  const EvalSummary base = Evaluate(data, params);
+  const double u0 = 600.0 - 500.0 * 0.9 / 17.75, u1 = 600.0 + 500.0 * 0.9 / 17.75;
+  const auto with_region = [&](ImageBox region) {
+    EvalParams p = params;
+    DontCareRegions dc;
+    dc.camera.rect_from_sensor = cam.rect_from_sensor;
+    dc.camera.P = cam.P;
+    dc.camera.image_width = 1200;
+    dc.camera.image_height = 360;
+    for (int k = 0; k < vtrack::testing::kScans; ++k) dc.boxes[k].push_back(region);
+    p.dont_care = dc;
+    EXPECT_EQ(p.Validate(), "");
+    return Evaluate(data, p);
+  };
+  // Wholly inside: dropped in every scan.
+  const EvalSummary whole = with_region({560.0, 170.0, 640.0, 240.0});
+  EXPECT_EQ(whole.dont_care_track_detections, vtrack::testing::kScans);
+  EXPECT_EQ(whole.clear.false_positives, base.clear.false_positives - vtrack::testing::kScans);
+  EXPECT_EQ(whole.clear.true_positives, base.clear.true_positives);
+  // 40 % of its width inside: still a false positive; 60 %: dropped.
+  const EvalSummary part40 = with_region({500.0, 0.0, u0 + 0.4 * (u1 - u0), 359.0});
+  EXPECT_EQ(part40.dont_care_track_detections, 0);
+  EXPECT_EQ(part40.clear.false_positives, base.clear.false_positives);
+  const EvalSummary part60 = with_region({500.0, 0.0, u0 + 0.6 * (u1 - u0), 359.0});
+  EXPECT_EQ(part60.dont_care_track_detections, vtrack::testing::kScans);
+  // Below it in the image (v > 228.732): no overlap.
+  EXPECT_EQ(with_region({560.0, 230.0, 640.0, 300.0}).dont_care_track_detections, 0);
+  // The whole image: every unmatched track in view is dropped, no matched one.
+  const EvalSummary all = with_region({0.0, 0.0, 1199.0, 359.0});
+  EXPECT_EQ(all.clear.true_positives, base.clear.true_positives);
+  EXPECT_EQ(all.clear.false_positives, 0);
+  EXPECT_GE(all.dont_care_track_detections, vtrack::testing::kScans);
+  // Without the camera region it cannot be placed: refused.
+  EvalParams bad;
+  bad.dont_care = DontCareRegions{};
+  EXPECT_NE(bad.Validate().find("dont_care needs region_camera"), std::string::npos);
+}
+
 TEST_F(EvaluatorTest, ModesAndDuplicates) {
   const std::string other = dir_ + "/tracks_ism.lcm";
   vtrack::testing::WriteSyntheticTracks(other, "ism", 0.6);

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <numbers>
 #include <limits>
 #include <set>
@@ -25,6 +26,38 @@
 
 namespace vtrack::testing {
 namespace {
+
+// A KITTI calibration file with P0..P3 = [500 0 600 0; 0 500 180 0; 0 0 1 0], R0_rect = I and
+// Tr_velo_to_cam the axis permutation (velo x forward, y left, z up -> cam x right, y down,
+// z forward). Returns path.
+std::string WriteAxisPermutationCalib(const std::string& path) {
+  std::ofstream c(path);
+  const char* p = "500 0 600 0 0 500 180 0 0 0 1 0";
+  c << "P0: " << p << "\nP1: " << p << "\nP2: " << p << "\nP3: " << p << "\n"
+    << "R0_rect: 1 0 0 0 1 0 0 0 1\n"
+    << "Tr_velo_to_cam: 0 -1 0 0 0 0 -1 0 1 0 0 0\n"
+    << "Tr_imu_to_velo: 1 0 0 0 0 1 0 0 0 0 1 0\n";
+  return path;
+}
+
+// Copies the log in to out, each TRACKS message (the k-th, from 0) passed through edit.
+void RewriteTracks(const std::string& in_path, const std::string& out_path,
+                   const std::function<void(int, vtrack::track_list_t*)>& edit) {
+  lcm_util::LogReader in(in_path);
+  lcm_util::LogWriter w(out_path);
+  int k = 0;
+  while (const lcm::LogEvent* ev = in.Next()) {
+    if (ev->channel != "TRACKS") {
+      w.Write(ev->timestamp, ev->channel, ev->data, static_cast<std::size_t>(ev->datalen));
+      continue;
+    }
+    vtrack::track_list_t m;
+    ASSERT_EQ(lcm_util::Decode(ev->data, static_cast<std::size_t>(ev->datalen), &m),
+              lcm_util::DecodeError::kNone);
+    edit(k++, &m);
+    w.WriteMessage(ev->timestamp, "TRACKS", m);
+  }
+}
 
 class EvalCliTest : public ToolTest {
  protected:
@@ -144,15 +177,7 @@ TEST_F(EvalCliTest, KittiExportFollowsTheCalibration) {
   // A calibration with P2 = [500 0 600 0; 0 500 180 0; 0 0 1 0], R0_rect = I and
   // Tr_velo_to_cam the axis permutation (velo x forward, y left, z up -> cam x right, y down,
   // z forward). The world is the velo frame (the ego stays at the origin).
-  const std::string calib = dir_ + "/calib.txt";
-  {
-    std::ofstream c(calib);
-    const char* p = "500 0 600 0 0 500 180 0 0 0 1 0";
-    c << "P0: " << p << "\nP1: " << p << "\nP2: " << p << "\nP3: " << p << "\n"
-      << "R0_rect: 1 0 0 0 1 0 0 0 1\n"
-      << "Tr_velo_to_cam: 0 -1 0 0 0 0 -1 0 1 0 0 0\n"
-      << "Tr_imu_to_velo: 1 0 0 0 0 1 0 0 0 0 1 0\n";
-  }
+  const std::string calib = WriteAxisPermutationCalib(dir_ + "/calib.txt");
   const std::string out_file = dir_ + "/kitti.txt";
   std::string out;
   ASSERT_EQ(RunTool({run_, tracks_, "--kitti-calib", calib, "--kitti-out", out_file,
@@ -198,39 +223,19 @@ TEST_F(EvalCliTest, KittiExportFollowsTheCalibration) {
 // z = -1.2 m (world = velo here: ego and sensor at the origin) and height 1.9 m: bottom centre
 // velo (10, -5, -1.2) -> cam (5, 1.2, 10), h 1.9.
 TEST_F(EvalCliTest, KittiExportTakesATracksBottomAndHeightFromItsBoxes) {
-  const std::string calib = dir_ + "/calib_z.txt";
-  {
-    std::ofstream c(calib);
-    const char* p = "500 0 600 0 0 500 180 0 0 0 1 0";
-    c << "P0: " << p << "\nP1: " << p << "\nP2: " << p << "\nP3: " << p << "\n"
-      << "R0_rect: 1 0 0 0 1 0 0 0 1\n"
-      << "Tr_velo_to_cam: 0 -1 0 0 0 0 -1 0 1 0 0 0\n"
-      << "Tr_imu_to_velo: 1 0 0 0 0 1 0 0 0 0 1 0\n";
-  }
+  const std::string calib = WriteAxisPermutationCalib(dir_ + "/calib_z.txt");
   const std::string tracks_z = dir_ + "/tracks_z.lcm";
-  {
-    lcm_util::LogReader in(tracks_);
-    lcm_util::LogWriter w(tracks_z);
-    while (const lcm::LogEvent* ev = in.Next()) {
-      if (ev->channel != "TRACKS") {
-        w.Write(ev->timestamp, ev->channel, ev->data, static_cast<std::size_t>(ev->datalen));
-        continue;
+  RewriteTracks(tracks_, tracks_z, [](int, vtrack::track_list_t* m) {
+    for (auto& t : m->tracks) {
+      if (t.id == 3) {  // classed other but measured by boxes: exported too
+        t.z = -1.5;
+        t.height = 1.4;
       }
-      vtrack::track_list_t m;
-      ASSERT_EQ(lcm_util::Decode(ev->data, static_cast<std::size_t>(ev->datalen), &m),
-                lcm_util::DecodeError::kNone);
-      for (auto& t : m.tracks) {
-        if (t.id == 3) {  // classed other but measured by boxes: exported too
-          t.z = -1.5;
-          t.height = 1.4;
-        }
-        if (t.id != 2) continue;
-        t.z = -1.2;
-        t.height = 1.9;
-      }
-      w.WriteMessage(ev->timestamp, "TRACKS", m);
+      if (t.id != 2) continue;
+      t.z = -1.2;
+      t.height = 1.9;
     }
-  }
+  });
   const std::string out_file = dir_ + "/kitti_z.txt";
   std::string out;
   ASSERT_EQ(RunTool({run_, tracks_z, "--kitti-calib", calib, "--kitti-out", out_file,
@@ -269,15 +274,7 @@ TEST_F(EvalCliTest, KittiExportTakesATracksBottomAndHeightFromItsBoxes) {
 // box track (height finite) whose status and update count follow a script, and track 8, a copy
 // measured by scans only (no height) and tentative throughout. Expected frames counted by hand.
 TEST_F(EvalCliTest, KittiExportWritesTentativeBoxTracksAndAShortCoast) {
-  const std::string calib = dir_ + "/calib_s.txt";
-  {
-    std::ofstream c(calib);
-    const char* p = "500 0 600 0 0 500 180 0 0 0 1 0";
-    c << "P0: " << p << "\nP1: " << p << "\nP2: " << p << "\nP3: " << p << "\n"
-      << "R0_rect: 1 0 0 0 1 0 0 0 1\n"
-      << "Tr_velo_to_cam: 0 -1 0 0 0 0 -1 0 1 0 0 0\n"
-      << "Tr_imu_to_velo: 1 0 0 0 0 1 0 0 0 0 1 0\n";
-  }
+  const std::string calib = WriteAxisPermutationCalib(dir_ + "/calib_s.txt");
   // Frame k: status and num_updates of track 2.
   //   0, 1: tentative, 1 and 2 updates (measured); 2: tentative, still 2 (missed); 3: tentative, 3;
   //   4-9: confirmed, 4-9; 10-13: coasting, 9; 14 on: confirmed, 10 on.
@@ -291,38 +288,24 @@ TEST_F(EvalCliTest, KittiExportWritesTentativeBoxTracksAndAShortCoast) {
     return {T::STATUS_CONFIRMED, k - 4};
   };
   const std::string tracks_s = dir_ + "/tracks_s.lcm";
-  {
-    lcm_util::LogReader in(tracks_);
-    lcm_util::LogWriter w(tracks_s);
-    int k = 0;
-    while (const lcm::LogEvent* ev = in.Next()) {
-      if (ev->channel != "TRACKS") {
-        w.Write(ev->timestamp, ev->channel, ev->data, static_cast<std::size_t>(ev->datalen));
-        continue;
-      }
-      vtrack::track_list_t m;
-      ASSERT_EQ(lcm_util::Decode(ev->data, static_cast<std::size_t>(ev->datalen), &m),
-                lcm_util::DecodeError::kNone);
-      std::vector<vtrack::track_t> kept;
-      for (auto t : m.tracks) {
-        if (t.id != 2) continue;
-        t.z = -1.2;
-        t.height = 1.9;
-        std::tie(t.status, t.num_updates) = script(k);
-        kept.push_back(t);
-        vtrack::track_t scan_only = t;
-        scan_only.id = 8;
-        scan_only.status = vtrack::track_t::STATUS_TENTATIVE;
-        scan_only.z = scan_only.height = std::numeric_limits<double>::quiet_NaN();
-        scan_only.num_updates = k + 1;
-        kept.push_back(scan_only);
-      }
-      m.tracks = kept;
-      m.num_tracks = static_cast<std::int32_t>(kept.size());
-      w.WriteMessage(ev->timestamp, "TRACKS", m);
-      ++k;
+  RewriteTracks(tracks_, tracks_s, [&](int k, vtrack::track_list_t* m) {
+    std::vector<vtrack::track_t> kept;
+    for (auto t : m->tracks) {
+      if (t.id != 2) continue;
+      t.z = -1.2;
+      t.height = 1.9;
+      std::tie(t.status, t.num_updates) = script(k);
+      kept.push_back(t);
+      vtrack::track_t scan_only = t;
+      scan_only.id = 8;
+      scan_only.status = vtrack::track_t::STATUS_TENTATIVE;
+      scan_only.z = scan_only.height = std::numeric_limits<double>::quiet_NaN();
+      scan_only.num_updates = k + 1;
+      kept.push_back(scan_only);
     }
-  }
+    m->tracks = kept;
+    m->num_tracks = static_cast<std::int32_t>(kept.size());
+  });
   const auto frames_written = [&](const std::vector<std::string>& extra) {
     const std::string out_file = dir_ + "/kitti_s.txt";
     std::vector<std::string> args = {run_, tracks_s, "--kitti-calib", calib, "--kitti-out", out_file,

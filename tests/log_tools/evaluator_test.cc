@@ -26,6 +26,19 @@ using vtrack::testing::kScans;
 
 constexpr double kPi = std::numbers::pi;
 
+// A camera looking along the sensor's x axis, f = 500 px, principal point (cx, cy): rect (x
+// right, y down, z forward) from sensor (x forward, y left, z up).
+CameraRegion AxisPermutationCamera(double cx, double cy, int width) {
+  CameraRegion cam;
+  Eigen::Matrix3d r;
+  r << 0, -1, 0, 0, 0, -1, 1, 0, 0;
+  cam.rect_from_sensor = Eigen::Affine3d::Identity();
+  cam.rect_from_sensor.linear() = r;
+  cam.P << 500, 0, cx, 0, 0, 500, cy, 0, 0, 0, 1, 0;
+  cam.width = width;
+  return cam;
+}
+
 class EvaluatorTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -122,13 +135,7 @@ TEST_F(EvaluatorTest, RangeAndFieldOfViewRegion) {
 TEST_F(EvaluatorTest, CameraRegion) {
   // A camera looking along the sensor's x axis with a +-45 deg horizontal view (f = cx = 500 px,
   // width 1000): rect (x right, y down, z forward) from sensor (x forward, y left, z up).
-  CameraRegion cam;
-  Eigen::Matrix3d r;
-  r << 0, -1, 0, 0, 0, -1, 1, 0, 0;
-  cam.rect_from_sensor = Eigen::Affine3d::Identity();
-  cam.rect_from_sensor.linear() = r;
-  cam.P << 500, 0, 500, 0, 0, 500, 200, 0, 0, 0, 1, 0;
-  cam.width = 1000;
+  const CameraRegion cam = AxisPermutationCamera(500.0, 200.0, 1000);
   EXPECT_TRUE(cam.Contains({10.0, 0.0, -1.0}));
   EXPECT_TRUE(cam.Contains({10.0, 9.9, -1.0}));    // 44.7 deg to the left
   EXPECT_FALSE(cam.Contains({10.0, 10.1, -1.0}));  // 45.3 deg
@@ -156,13 +163,7 @@ TEST_F(EvaluatorTest, CameraRegion) {
 // u = 600 - 500 y / x in [600 - 25.352, 600 + 25.352] and v = 180 - 500 z / x in
 // [180 + 500 * 0.13 / 22.25, 180 + 500 * 1.73 / 17.75] = [182.921, 228.732].
 TEST_F(EvaluatorTest, KittiDontCareRegionsDropUnmatchedTracksMostlyInside) {
-  CameraRegion cam;
-  Eigen::Matrix3d r;
-  r << 0, -1, 0, 0, 0, -1, 1, 0, 0;
-  cam.rect_from_sensor = Eigen::Affine3d::Identity();
-  cam.rect_from_sensor.linear() = r;
-  cam.P << 500, 0, 600, 0, 0, 500, 180, 0, 0, 0, 1, 0;
-  cam.width = 1200;
+  const CameraRegion cam = AxisPermutationCamera(600.0, 180.0, 1200);
   EvalParams params;
   params.region_camera = cam;
   LogData data = LoadLogs({run_, tracks_}, params);

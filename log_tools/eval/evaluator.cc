@@ -434,6 +434,22 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params,
       return true;
     };
 
+    // KITTI's DontCare rule (EvalParams::dont_care): the track's image box lies in one of this
+    // frame's DontCare regions by more than min_overlap of its area.
+    const auto in_dont_care = [&](const vtrack::track_t& tr, const TrackPose& tp) {
+      if (!params.dont_care || !ego) return false;
+      const auto regions = params.dont_care->boxes.find(list.scan_seq);
+      if (regions == params.dont_care->boxes.end()) return false;
+      const Eigen::Isometry3d sensor_from_world = (*ego * body_from_sensor).inverse();
+      const std::optional<ImageBox> image = ProjectToImage(
+          TrackBoxInSensor(tr, tp.x, tp.y, tp.theta, sensor_from_world, params.dont_care->camera),
+          tr.length, tr.width, params.dont_care->camera);
+      return image && std::any_of(regions->second.begin(), regions->second.end(),
+                                  [&](const ImageBox& r) {
+                                    return OverlapOfFirst(*image, r) > params.dont_care->min_overlap;
+                                  });
+    };
+
     ScoringFrame f;
     f.utime = utime;
     std::vector<const vtrack::object_t*> scored, all_truth;
@@ -489,7 +505,7 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params,
         if (!in_region(tp.x, tp.y, std::nullopt)) {
           row.label = -1;
         } else if (!gated) {
-          row.label = 0;
+          row.label = in_dont_care(tr, tp) ? -1 : 0;  // KITTI labels nothing there
         } else if (truth_scored[nearest]) {
           row.label = 1;
         } else if (IsVehicleClass(all_truth[nearest]->object_class) ||
@@ -537,24 +553,9 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params,
         ++s.outside_region_track_detections;
         continue;
       }
-      if (partner[j] < 0 && params.dont_care && ego) {
-        const auto regions = params.dont_care->boxes.find(list.scan_seq);
-        if (regions != params.dont_care->boxes.end()) {
-          const Eigen::Isometry3d sensor_from_world = (*ego * body_from_sensor).inverse();
-          const std::optional<ImageBox> image =
-              ProjectToImage(TrackBoxInSensor(*tr, tp.x, tp.y, tp.theta, sensor_from_world,
-                                              params.dont_care->camera),
-                             tr->length, tr->width, params.dont_care->camera);
-          const bool inside = image && std::any_of(regions->second.begin(), regions->second.end(),
-                                                   [&](const ImageBox& r) {
-                                                     return OverlapOfFirst(*image, r) >
-                                                            params.dont_care->min_overlap;
-                                                   });
-          if (inside) {
-            ++s.dont_care_track_detections;
-            continue;
-          }
-        }
+      if (partner[j] < 0 && in_dont_care(*tr, tp)) {
+        ++s.dont_care_track_detections;
+        continue;
       }
       kept.push_back(tr);
       kept_pose.push_back(tp);

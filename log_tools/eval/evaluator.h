@@ -216,7 +216,8 @@ struct TrackLabel {
   // the region); 0: it is of another class (wall, pole, pedestrian, ...) or no truth object is
   // within gate_m; -1 (ignore): the track centre is outside the scoring region, or the nearest
   // truth within gate_m is an unscored vehicle (outside the labelled region or the scoring
-  // region) or of CLASS_UNKNOWN (KITTI DontCare).
+  // region) or of CLASS_UNKNOWN, or no truth object is within gate_m and the track lies in a
+  // KITTI DontCare region (EvalParams::dont_care).
   int label = 0;
   double range_m = 0.0;       // [m] track centre from the ego position; NaN without an ego pose
   std::int64_t truth_id = -1;      // nearest truth object within gate_m; -1 if none

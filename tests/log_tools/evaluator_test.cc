@@ -185,6 +185,7 @@ TEST_F(EvaluatorTest, KittiDontCareRegionsDropUnmatchedTracksMostlyInside) {
   }
   const EvalSummary base = Evaluate(data, params);
   const double u0 = 600.0 - 500.0 * 0.9 / 17.75, u1 = 600.0 + 500.0 * 0.9 / 17.75;
+  std::vector<TrackLabel> labels;
   const auto with_region = [&](ImageBox region) {
     EvalParams p = params;
     DontCareRegions dc;
@@ -195,17 +196,29 @@ TEST_F(EvaluatorTest, KittiDontCareRegionsDropUnmatchedTracksMostlyInside) {
     for (int k = 0; k < vtrack::testing::kScans; ++k) dc.boxes[k].push_back(region);
     p.dont_care = dc;
     EXPECT_EQ(p.Validate(), "");
-    return Evaluate(data, p);
+    labels.clear();
+    return Evaluate(data, p, &labels);
+  };
+  // The labelled set of --track-labels: track 99 is not a vehicle (0) outside the regions and
+  // ignored (-1) inside one, in every scored scan.
+  const auto labels_of_99 = [&] {
+    std::map<int, int> count;
+    for (const TrackLabel& l : labels) {
+      if (l.track_id == 99) ++count[l.label];
+    }
+    return count;
   };
   // Wholly inside: dropped in every scan.
   const EvalSummary whole = with_region({560.0, 170.0, 640.0, 240.0});
   EXPECT_EQ(whole.dont_care_track_detections, vtrack::testing::kScans);
   EXPECT_EQ(whole.clear.false_positives, base.clear.false_positives - vtrack::testing::kScans);
   EXPECT_EQ(whole.clear.true_positives, base.clear.true_positives);
+  EXPECT_EQ(labels_of_99(), (std::map<int, int>{{-1, vtrack::testing::kScans}}));
   // 40 % of its width inside: still a false positive; 60 %: dropped.
   const EvalSummary part40 = with_region({500.0, 0.0, u0 + 0.4 * (u1 - u0), 359.0});
   EXPECT_EQ(part40.dont_care_track_detections, 0);
   EXPECT_EQ(part40.clear.false_positives, base.clear.false_positives);
+  EXPECT_EQ(labels_of_99(), (std::map<int, int>{{0, vtrack::testing::kScans}}));
   const EvalSummary part60 = with_region({500.0, 0.0, u0 + 0.6 * (u1 - u0), 359.0});
   EXPECT_EQ(part60.dont_care_track_detections, vtrack::testing::kScans);
   // Below it in the image (v > 228.732): no overlap.

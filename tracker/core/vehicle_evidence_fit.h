@@ -6,37 +6,37 @@
 
 namespace vtrack::evidence_fit {
 
-inline constexpr double kPrior = 0.206066116;
+inline constexpr double kPrior = 0.211098197;
 inline constexpr double kScanWeight = 0.5;
 inline constexpr EvidenceAccumulation kAccumulation = EvidenceAccumulation::kAverage;
-inline constexpr double kBias3D = -2.07420732;
+inline constexpr double kBias3D = -2.05190741;
 inline const std::vector<EvidenceTerm> kTerms3D = {
-    {EvidenceFeature::kLogPoints, 1, 4.03811412, 1.93108441, 0.557073622},
-    {EvidenceFeature::kLogPoints, 2, 4.03811412, 1.93108441, 0.95404321},
-    {EvidenceFeature::kLogRange, 1, 3.47444706, 0.668847339, -0.471975373},
-    {EvidenceFeature::kLogRange, 2, 3.47444706, 0.668847339, -0.807199674},
-    {EvidenceFeature::kLength, 1, 3.68002503, 4.66784049, 0.967785659},
-    {EvidenceFeature::kLength, 2, 3.68002503, 4.66784049, -1.1043403},
-    {EvidenceFeature::kWidth, 1, 1.03417744, 2.00626933, 1.75594836},
-    {EvidenceFeature::kWidth, 2, 1.03417744, 2.00626933, -0.679300288},
-    {EvidenceFeature::kSegmentExtent, 1, 3.55558434, 4.82850641, 0.35178734},
-    {EvidenceFeature::kSegmentExtent, 2, 3.55558434, 4.82850641, -0.869201036},
-    {EvidenceFeature::kSpeed, 1, 1.42928593, 3.14727725, -1.72371132},
-    {EvidenceFeature::kSpeed, 2, 1.42928593, 3.14727725, 0.193405265},
-    {EvidenceFeature::kMover, 1, 0.0163238911, 0.126717882, 0.721362325},
-    {EvidenceFeature::kSmall, 1, 0.343918714, 0.475014349, -0.534312161},
-    {EvidenceFeature::kHeightMax, 1, 1.9239383, 0.615911508, -0.893092443},
-    {EvidenceFeature::kHeightMax, 2, 1.9239383, 0.615911508, -0.641316689},
-    {EvidenceFeature::kHeightMedian, 1, 1.26428538, 0.436179239, 0.756562324},
-    {EvidenceFeature::kHeightMedian, 2, 1.26428538, 0.436179239, -0.0533399959},
-    {EvidenceFeature::kHeightMin, 1, 0.512138799, 0.393951328, -2.14896107},
-    {EvidenceFeature::kHeightMin, 2, 0.512138799, 0.393951328, 0.401301063},
-    {EvidenceFeature::kColumnTop, 1, 1.89594597, 0.662877266, -0.311271677},
-    {EvidenceFeature::kColumnTop, 2, 1.89594597, 0.662877266, -0.17033612},
-    {EvidenceFeature::kTopBeam, 1, 0.731035156, 1.34592548, -2.34247648},
-    {EvidenceFeature::kTopBeam, 2, 0.731035156, 1.34592548, 0.480396276},
+    {EvidenceFeature::kLogPoints, 1, 4.0417146, 1.93175174, 0.642226833},
+    {EvidenceFeature::kLogPoints, 2, 4.0417146, 1.93175174, 0.963055301},
+    {EvidenceFeature::kLogRange, 1, 3.47471187, 0.669708428, -0.437429401},
+    {EvidenceFeature::kLogRange, 2, 3.47471187, 0.669708428, -0.828211593},
+    {EvidenceFeature::kLength, 1, 3.68934641, 4.67217036, 0.893848162},
+    {EvidenceFeature::kLength, 2, 3.68934641, 4.67217036, -1.10070171},
+    {EvidenceFeature::kWidth, 1, 1.03596434, 2.00914623, 1.67028039},
+    {EvidenceFeature::kWidth, 2, 1.03596434, 2.00914623, -0.66193512},
+    {EvidenceFeature::kSegmentExtent, 1, 3.56209704, 4.83354183, 0.315214365},
+    {EvidenceFeature::kSegmentExtent, 2, 3.56209704, 4.83354183, -0.850298741},
+    {EvidenceFeature::kSpeed, 1, 1.42973144, 3.14930204, -1.70973711},
+    {EvidenceFeature::kSpeed, 2, 1.42973144, 3.14930204, 0.192464692},
+    {EvidenceFeature::kMover, 1, 0.0163779713, 0.126924125, 0.710796325},
+    {EvidenceFeature::kSmall, 1, 0.343386878, 0.474839268, -0.511842832},
+    {EvidenceFeature::kHeightMax, 1, 1.92471021, 0.615001401, -0.843414291},
+    {EvidenceFeature::kHeightMax, 2, 1.92471021, 0.615001401, -0.635407982},
+    {EvidenceFeature::kHeightMedian, 1, 1.26461387, 0.435284402, 0.715370214},
+    {EvidenceFeature::kHeightMedian, 2, 1.26461387, 0.435284402, -0.0258375167},
+    {EvidenceFeature::kHeightMin, 1, 0.511903231, 0.39356208, -2.07733291},
+    {EvidenceFeature::kHeightMin, 2, 0.511903231, 0.39356208, 0.387558408},
+    {EvidenceFeature::kColumnTop, 1, 1.89693068, 0.66215108, -0.325484009},
+    {EvidenceFeature::kColumnTop, 2, 1.89693068, 0.66215108, -0.1724384},
+    {EvidenceFeature::kTopBeam, 1, 0.7316209, 1.34676782, -2.37290813},
+    {EvidenceFeature::kTopBeam, 2, 0.7316209, 1.34676782, 0.491135954},
 };
-inline constexpr double kBias2D = 0.783521953;
+inline constexpr double kBias2D = 0.814006629;
 inline const std::vector<EvidenceTerm> kTerms2D = {
     {EvidenceFeature::kLogPoints, 1, 2.5694787, 0.978242697, -0.214761244},
     {EvidenceFeature::kLogPoints, 2, 2.5694787, 0.978242697, 0.0298218165},

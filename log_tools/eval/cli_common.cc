@@ -150,6 +150,11 @@ EvalParams MakeEvalParams(const EvalCliOptions& o) {
       }
       for (const kitti::Label& l : labels) {
         if (!l.IsDontCare()) continue;
+        if (!(l.bbox(2) >= l.bbox(0) && l.bbox(3) >= l.bbox(1))) {
+          throw std::invalid_argument("--kitti-dontcare: " + o.kitti_dont_care + ":" +
+                                      std::to_string(l.line) +
+                                      ": DontCare box with x2 < x1 or y2 < y1");
+        }
         dc.boxes[l.frame].push_back({l.bbox(0), l.bbox(1), l.bbox(2), l.bbox(3)});
       }
       p.dont_care = std::move(dc);

@@ -341,6 +341,9 @@ int RunCompare(const CompareOptions& o) {
         kopt.region_camera = true;
         kopt.region_range_m = o.kitti_range_m;
         if (o.kitti_dont_care) kopt.kitti_dont_care = FindKittiLabels(o, item);
+        if (o.kitti_dont_care && kopt.kitti_dont_care.empty()) {
+          say(item.name + ": no label_02 file: no DontCare regions");
+        }
         // With scans, the labels are half a sweep after the scan's utime.
         if (!boxes_only) kopt.truth_time_offset = "half-sweep";
         params = MakeEvalParams(kopt);
@@ -352,6 +355,9 @@ int RunCompare(const CompareOptions& o) {
         kopt.region_camera = true;
         kopt.region_range_m = o.kitti_range_m;
         if (o.kitti_dont_care) kopt.kitti_dont_care = FindKittiLabels(o, item);
+        if (o.kitti_dont_care && kopt.kitti_dont_care.empty()) {
+          say(item.name + ": no label_02 file: no DontCare regions");
+        }
         params = MakeEvalParams(kopt);  // no scans: the truth and the boxes share the frame's time
       }
       if (o.reuse && fs::is_regular_file(run)) {

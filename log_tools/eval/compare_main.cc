@@ -83,6 +83,11 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (!o.eval.mode.empty()) throw std::invalid_argument("--mode is not an option here: use --modes");
+    if (!o.eval.kitti_dont_care.empty()) {
+      throw std::invalid_argument("--kitti-dontcare is not an option here: each KITTI sequence's "
+                                  "label_02 file gives its DontCare regions (--kitti-no-dontcare: "
+                                  "none)");
+    }
     if (o.reuse && o.work_dir.empty()) throw std::invalid_argument("--reuse needs --work-dir");
     for (const auto& s : SplitList(scenarios)) o.items.push_back(ScenarioItem(s));
     if (!kitti_dirs.empty()) {

@@ -400,7 +400,10 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params,
   std::vector<std::vector<const vtrack::track_t*>> frame_tracks;
   std::vector<std::vector<TrackPose>> frame_track_poses;  // advanced by the truth time offset
 
+  std::int64_t list_index = 0;
+  bool dont_care_frame_found = false;  // a DontCare test met a frame with regions
   for (const auto& [utime, list] : track_lists) {
+    const std::int64_t kitti_frame = KittiFrame(list, list_index++);
     const auto gt_it = data.truth.find(utime);
     if (gt_it == data.truth.end()) {
       ++s.tracks_without_truth;
@@ -436,11 +439,14 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params,
 
     // KITTI's DontCare rule (EvalParams::dont_care): the track's image box lies in one of this
     // frame's DontCare regions by more than min_overlap of its area.
+    // The camera where it was at the truth's time, as the track (tp, advanced to that time).
     const auto in_dont_care = [&](const vtrack::track_t& tr, const TrackPose& tp) {
-      if (!params.dont_care || !ego) return false;
-      const auto regions = params.dont_care->boxes.find(list.scan_seq);
+      if (!params.dont_care) return false;
+      const auto regions = params.dont_care->boxes.find(kitti_frame);
       if (regions == params.dont_care->boxes.end()) return false;
-      const Eigen::Isometry3d sensor_from_world = (*ego * body_from_sensor).inverse();
+      const auto camera_pose = data.poses.At(utime + offset_us, max_pose_gap_us);
+      if (!camera_pose) return false;
+      const Eigen::Isometry3d sensor_from_world = (*camera_pose * body_from_sensor).inverse();
       const std::optional<ImageBox> image = ProjectToImage(
           TrackBoxInSensor(tr, tp.x, tp.y, tp.theta, sensor_from_world, params.dont_care->camera),
           tr.length, tr.width, params.dont_care->camera);
@@ -450,6 +456,7 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params,
                                   });
     };
 
+    if (params.dont_care && params.dont_care->boxes.count(kitti_frame)) dont_care_frame_found = true;
     ScoringFrame f;
     f.utime = utime;
     std::vector<const vtrack::object_t*> scored, all_truth;
@@ -569,6 +576,10 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params,
   }
   for (const auto& [utime, gt] : data.truth) {
     if (!track_lists.count(utime)) ++s.scans_without_tracks;
+  }
+  if (params.dont_care && !params.dont_care->boxes.empty() && !dont_care_frame_found) {
+    // DontCare regions given, none of them in a scored frame: labels of another sequence?
+    s.problems["kitti_dontcare_regions_in_no_scored_frame"] = 1;
   }
   if (frames.empty()) {
     throw std::runtime_error("no scan has both ground truth and tracks of mode '" + s.mode +

@@ -62,12 +62,4 @@ std::optional<ImageBox> ProjectToImage(const SensorBox& b, double length, double
   return box;
 }
 
-double OverlapOfFirst(const ImageBox& a, const ImageBox& b) {
-  const double area = a.Area();
-  if (!(area > 0.0)) return 0.0;
-  const double iw = std::min(a.u1, b.u1) - std::max(a.u0, b.u0);
-  const double ih = std::min(a.v1, b.v1) - std::max(a.v0, b.v0);
-  return iw > 0.0 && ih > 0.0 ? iw * ih / area : 0.0;
-}
-
 }  // namespace vtrack::eval

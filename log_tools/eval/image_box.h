@@ -5,9 +5,12 @@
 
 #include <Eigen/Geometry>
 
+#include <cstdint>
 #include <optional>
 #include <string>
 
+#include "log_tools/eval/overlap.h"
+#include "vtrack/track_list_t.hpp"
 #include "vtrack/track_t.hpp"
 
 namespace vtrack::eval {
@@ -25,11 +28,11 @@ struct ImageProjection {
   std::string Validate() const;     // "" if valid, else names the key and the value
 };
 
-// An axis-aligned image box [px], u right, v down.
-struct ImageBox {
-  double u0 = 0.0, v0 = 0.0, u1 = 0.0, v1 = 0.0;
-  double Area() const { return (u1 - u0) * (v1 - v0); }
-};
+// The KITTI frame of the index-th track list of a log (from 0): its scan_seq (the frame index in
+// logs from vtrack-kitti2lcm), or the index where the list has none (scan_seq < 0).
+inline std::int64_t KittiFrame(const vtrack::track_list_t& list, std::int64_t index) {
+  return list.scan_seq >= 0 ? list.scan_seq : index;
+}
 
 // The box of a track in the sensor frame: bottom centre, unit heading in the sensor's xy plane,
 // and the height used.
@@ -48,8 +51,5 @@ SensorBox TrackBoxInSensor(const vtrack::track_t& tr, double x, double y, double
 // nullopt if a corner lies behind the camera (rect z < 0.1 m) or nothing of it is in the image.
 std::optional<ImageBox> ProjectToImage(const SensorBox& b, double length, double width,
                                        const ImageProjection& cam);
-
-// Area of a's intersection with b over a's own area (0 if a is empty): KITTI's "a" overlap.
-double OverlapOfFirst(const ImageBox& a, const ImageBox& b);
 
 }  // namespace vtrack::eval

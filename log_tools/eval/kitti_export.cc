@@ -61,8 +61,7 @@ KittiExportStats ExportKittiTracking(const LogData& data, const std::string& mod
   std::int64_t index = 0;
   for (const auto& [utime, list] : lists->second) {
     ++stats.frames;
-    const std::int64_t frame = list.scan_seq >= 0 ? list.scan_seq : index;
-    ++index;
+    const std::int64_t frame = KittiFrame(list, index++);
     const auto ego = data.poses.At(utime + offset_us, 500'000);
     if (!ego) ++stats.frames_without_pose;  // its tracks still count as measured below
     const Eigen::Isometry3d sensor_from_world =

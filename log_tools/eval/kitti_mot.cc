@@ -1,4 +1,5 @@
 #include "log_tools/eval/kitti_mot.h"
+#include "log_tools/eval/overlap.h"
 
 #include <algorithm>
 #include <cctype>
@@ -102,11 +103,7 @@ std::int64_t ParseInteger(const std::string& field, const std::string& where, co
 // 2-D overlap of a tracker box with a DontCare box, over the tracker box's area (devkit's
 // boxoverlap(..., "a")).
 double OverlapOverFirst(const KittiObject& a, const KittiObject& b) {
-  const double w = std::min(a.x2, b.x2) - std::max(a.x1, b.x1);
-  const double h = std::min(a.y2, b.y2) - std::max(a.y1, b.y1);
-  if (w <= 0.0 || h <= 0.0) return 0.0;
-  const double area = (a.x2 - a.x1) * (a.y2 - a.y1);
-  return area > 0.0 ? w * h / area : 0.0;
+  return OverlapOfFirst({a.x1, a.y1, a.x2, a.y2}, {b.x1, b.y1, b.x2, b.y2});
 }
 
 // Rule 9 for one ground-truth trajectory: (matched tracker id or -1, ignored) per appearance.

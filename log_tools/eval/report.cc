@@ -284,6 +284,7 @@ std::string SummaryJson(const EvalSummary& s) {
   w.Key("region_range_m").Number(p.region_range_m);
   w.Key("region_fov_deg").Number(p.region_fov_deg);
   w.Key("region_camera").Bool(p.region_camera.has_value());
+  w.Key("kitti_dont_care").Bool(p.dont_care.has_value());
   w.Key("truth_time_offset_s").Number(s.truth_time_offset_s);
   w.Key("max_truth_gap_s").Number(p.max_truth_gap_s);
   w.Key("moving_speed_mps").Number(p.moving_speed_mps);

@@ -49,6 +49,8 @@ TEST_F(CompareTest, HelpAndBadOptions) {
   EXPECT_NE(out.find("'foo'"), std::string::npos) << out;
   EXPECT_EQ(RunTool({"--scenarios", "a", "--gate", "-2"}, &out), 2);
   EXPECT_NE(out.find("gate_m"), std::string::npos) << out;
+  EXPECT_EQ(RunTool({"--scenarios", "a", "--kitti-dontcare", dir_ + "/labels.txt"}, &out), 2);
+  EXPECT_NE(out.find("--kitti-dontcare is not an option here"), std::string::npos) << out;
   EXPECT_EQ(RunTool({"--scenarios", "a", "--bin-dir", dir_ + "/nowhere"}, &out), 1);
   EXPECT_NE(out.find("vtrack-sim-log"), std::string::npos) << out;
 }
@@ -139,6 +141,21 @@ TEST_F(CompareTest, KittiInputModesGiveOneItemEach) {
   EXPECT_NEAR(j["kitti_0000"]["mht"]["params"]["truth_time_offset_s"].as<double>(), 0.05, 1e-12);
   EXPECT_NEAR(j["kitti_0000_fused"]["mht"]["params"]["truth_time_offset_s"].as<double>(), 0.05, 1e-12);
   EXPECT_NEAR(j["kitti_0000_boxes"]["mht"]["params"]["truth_time_offset_s"].as<double>(), 0.0, 1e-12);
+  // Without a label_02 file no DontCare regions; with one, every KITTI item is scored with them
+  // unless --kitti-no-dontcare.
+  EXPECT_FALSE(j["kitti_0000"]["mht"]["params"]["kitti_dont_care"].as<bool>());
+  fs::create_directories(kitti + "/label_02");
+  std::ofstream(kitti + "/label_02/0000.txt")
+      << "0 -1 DontCare -1 -1 -10 100 100 200 200 -1 -1 -1 -1000 -1000 -1000 -10\n";
+  for (const bool off : {false, true}) {
+    std::vector<std::string> args = {"--kitti", kitti, "--kitti-input-modes", "scans,boxes",
+                                     "--modes", "mht", "--bin-dir", fake_bin_, "--json", json};
+    if (off) args.push_back("--kitti-no-dontcare");
+    ASSERT_EQ(RunTool(args, &out, {"FAKE_TOOL_LOG=" + calls}), 0) << out;
+    const YAML::Node k = YAML::LoadFile(json);
+    EXPECT_EQ(k["kitti_0000"]["mht"]["params"]["kitti_dont_care"].as<bool>(), !off);
+    EXPECT_EQ(k["kitti_0000_boxes"]["mht"]["params"]["kitti_dont_care"].as<bool>(), !off);
+  }
 }
 
 TEST_F(CompareTest, AFailedModeIsReportedAndTheRestStillScored) {

@@ -186,14 +186,19 @@ TEST_F(EvaluatorTest, KittiDontCareRegionsDropUnmatchedTracksMostlyInside) {
   const EvalSummary base = Evaluate(data, params);
   const double u0 = 600.0 - 500.0 * 0.9 / 17.75, u1 = 600.0 + 500.0 * 0.9 / 17.75;
   std::vector<TrackLabel> labels;
-  const auto with_region = [&](ImageBox region) {
+  // The region in the given frames (KITTI frame = the list's scan_seq, k for scan k here), by
+  // default every scan's.
+  const auto with_region = [&](ImageBox region, std::vector<int> frames = {}) {
+    if (frames.empty()) {
+      for (int k = 0; k < vtrack::testing::kScans; ++k) frames.push_back(k);
+    }
     EvalParams p = params;
     DontCareRegions dc;
     dc.camera.rect_from_sensor = cam.rect_from_sensor;
     dc.camera.P = cam.P;
     dc.camera.image_width = 1200;
     dc.camera.image_height = 360;
-    for (int k = 0; k < vtrack::testing::kScans; ++k) dc.boxes[k].push_back(region);
+    for (const int k : frames) dc.boxes[k].push_back(region);
     p.dont_care = dc;
     EXPECT_EQ(p.Validate(), "");
     labels.clear();
@@ -221,6 +226,17 @@ TEST_F(EvaluatorTest, KittiDontCareRegionsDropUnmatchedTracksMostlyInside) {
   EXPECT_EQ(labels_of_99(), (std::map<int, int>{{0, vtrack::testing::kScans}}));
   const EvalSummary part60 = with_region({500.0, 0.0, u0 + 0.6 * (u1 - u0), 359.0});
   EXPECT_EQ(part60.dont_care_track_detections, vtrack::testing::kScans);
+  // Exactly half inside: still a false positive (the rule is "more than half").
+  EXPECT_EQ(with_region({500.0, 0.0, 0.5 * (u0 + u1), 359.0}).dont_care_track_detections, 0);
+  // Regions of frames 5 and 17 only: dropped in those two scans.
+  const EvalSummary two = with_region({560.0, 170.0, 640.0, 240.0}, {5, 17});
+  EXPECT_EQ(two.dont_care_track_detections, 2);
+  EXPECT_EQ(two.clear.false_positives, base.clear.false_positives - 2);
+  EXPECT_EQ(two.problems.count("kitti_dontcare_regions_in_no_scored_frame"), 0u);
+  // Regions of frames the log does not hold (another sequence's labels): said in the problems.
+  const EvalSummary none = with_region({560.0, 170.0, 640.0, 240.0}, {5000});
+  EXPECT_EQ(none.dont_care_track_detections, 0);
+  EXPECT_EQ(none.problems.count("kitti_dontcare_regions_in_no_scored_frame"), 1u);
   // Below it in the image (v > 228.732): no overlap.
   EXPECT_EQ(with_region({560.0, 230.0, 640.0, 300.0}).dont_care_track_detections, 0);
   // The whole image: every unmatched track in view is dropped, no matched one.

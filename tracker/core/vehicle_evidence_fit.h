@@ -6,37 +6,37 @@
 
 namespace vtrack::evidence_fit {
 
-inline constexpr double kPrior = 0.211098197;
+inline constexpr double kPrior = 0.210870988;
 inline constexpr double kScanWeight = 0.5;
 inline constexpr EvidenceAccumulation kAccumulation = EvidenceAccumulation::kAverage;
-inline constexpr double kBias3D = -2.05190741;
+inline constexpr double kBias3D = -2.06036739;
 inline const std::vector<EvidenceTerm> kTerms3D = {
-    {EvidenceFeature::kLogPoints, 1, 4.0417146, 1.93175174, 0.642226833},
-    {EvidenceFeature::kLogPoints, 2, 4.0417146, 1.93175174, 0.963055301},
-    {EvidenceFeature::kLogRange, 1, 3.47471187, 0.669708428, -0.437429401},
-    {EvidenceFeature::kLogRange, 2, 3.47471187, 0.669708428, -0.828211593},
-    {EvidenceFeature::kLength, 1, 3.68934641, 4.67217036, 0.893848162},
-    {EvidenceFeature::kLength, 2, 3.68934641, 4.67217036, -1.10070171},
-    {EvidenceFeature::kWidth, 1, 1.03596434, 2.00914623, 1.67028039},
-    {EvidenceFeature::kWidth, 2, 1.03596434, 2.00914623, -0.66193512},
-    {EvidenceFeature::kSegmentExtent, 1, 3.56209704, 4.83354183, 0.315214365},
-    {EvidenceFeature::kSegmentExtent, 2, 3.56209704, 4.83354183, -0.850298741},
-    {EvidenceFeature::kSpeed, 1, 1.42973144, 3.14930204, -1.70973711},
-    {EvidenceFeature::kSpeed, 2, 1.42973144, 3.14930204, 0.192464692},
-    {EvidenceFeature::kMover, 1, 0.0163779713, 0.126924125, 0.710796325},
-    {EvidenceFeature::kSmall, 1, 0.343386878, 0.474839268, -0.511842832},
-    {EvidenceFeature::kHeightMax, 1, 1.92471021, 0.615001401, -0.843414291},
-    {EvidenceFeature::kHeightMax, 2, 1.92471021, 0.615001401, -0.635407982},
-    {EvidenceFeature::kHeightMedian, 1, 1.26461387, 0.435284402, 0.715370214},
-    {EvidenceFeature::kHeightMedian, 2, 1.26461387, 0.435284402, -0.0258375167},
-    {EvidenceFeature::kHeightMin, 1, 0.511903231, 0.39356208, -2.07733291},
-    {EvidenceFeature::kHeightMin, 2, 0.511903231, 0.39356208, 0.387558408},
-    {EvidenceFeature::kColumnTop, 1, 1.89693068, 0.66215108, -0.325484009},
-    {EvidenceFeature::kColumnTop, 2, 1.89693068, 0.66215108, -0.1724384},
-    {EvidenceFeature::kTopBeam, 1, 0.7316209, 1.34676782, -2.37290813},
-    {EvidenceFeature::kTopBeam, 2, 0.7316209, 1.34676782, 0.491135954},
+    {EvidenceFeature::kLogPoints, 1, 4.04143831, 1.93182306, 0.640375854},
+    {EvidenceFeature::kLogPoints, 2, 4.04143831, 1.93182306, 0.960180914},
+    {EvidenceFeature::kLogRange, 1, 3.47466601, 0.669689122, -0.438146394},
+    {EvidenceFeature::kLogRange, 2, 3.47466601, 0.669689122, -0.826882256},
+    {EvidenceFeature::kLength, 1, 3.68904187, 4.67192901, 0.894673969},
+    {EvidenceFeature::kLength, 2, 3.68904187, 4.67192901, -1.10095653},
+    {EvidenceFeature::kWidth, 1, 1.03582209, 2.00900512, 1.6738419},
+    {EvidenceFeature::kWidth, 2, 1.03582209, 2.00900512, -0.656047403},
+    {EvidenceFeature::kSegmentExtent, 1, 3.56189923, 4.83352345, 0.307461113},
+    {EvidenceFeature::kSegmentExtent, 2, 3.56189923, 4.83352345, -0.846714975},
+    {EvidenceFeature::kSpeed, 1, 1.42913787, 3.1481215, -1.71399424},
+    {EvidenceFeature::kSpeed, 2, 1.42913787, 3.1481215, 0.192816786},
+    {EvidenceFeature::kMover, 1, 0.0163757175, 0.126915537, 0.711940532},
+    {EvidenceFeature::kSmall, 1, 0.343310136, 0.474813949, -0.508040348},
+    {EvidenceFeature::kHeightMax, 1, 1.92473488, 0.615049712, -0.839140937},
+    {EvidenceFeature::kHeightMax, 2, 1.92473488, 0.615049712, -0.623832074},
+    {EvidenceFeature::kHeightMedian, 1, 1.26471966, 0.435459499, 0.70687916},
+    {EvidenceFeature::kHeightMedian, 2, 1.26471966, 0.435459499, -0.038513483},
+    {EvidenceFeature::kHeightMin, 1, 0.511999687, 0.393709457, -2.08746862},
+    {EvidenceFeature::kHeightMin, 2, 0.511999687, 0.393709457, 0.394439318},
+    {EvidenceFeature::kColumnTop, 1, 1.89696687, 0.662218055, -0.322177529},
+    {EvidenceFeature::kColumnTop, 2, 1.89696687, 0.662218055, -0.177080136},
+    {EvidenceFeature::kTopBeam, 1, 0.731577435, 1.34667217, -2.37980481},
+    {EvidenceFeature::kTopBeam, 2, 0.731577435, 1.34667217, 0.493710648},
 };
-inline constexpr double kBias2D = 0.814006629;
+inline constexpr double kBias2D = 0.812641766;
 inline const std::vector<EvidenceTerm> kTerms2D = {
     {EvidenceFeature::kLogPoints, 1, 2.5694787, 0.978242697, -0.214761244},
     {EvidenceFeature::kLogPoints, 2, 2.5694787, 0.978242697, 0.0298218165},

@@ -404,6 +404,7 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params,
   bool dont_care_frame_found = false;  // a DontCare test met a frame with regions
   for (const auto& [utime, list] : track_lists) {
     const std::int64_t kitti_frame = KittiFrame(list, list_index++);
+    const std::int64_t scan_utime = utime;  // lambdas take a copy: clang 14 cannot capture a structured binding
     const auto gt_it = data.truth.find(utime);
     if (gt_it == data.truth.end()) {
       ++s.tracks_without_truth;
@@ -444,7 +445,7 @@ EvalSummary Evaluate(const LogData& data, const EvalParams& params,
       if (!params.dont_care) return false;
       const auto regions = params.dont_care->boxes.find(kitti_frame);
       if (regions == params.dont_care->boxes.end()) return false;
-      const auto camera_pose = data.poses.At(utime + offset_us, max_pose_gap_us);
+      const auto camera_pose = data.poses.At(scan_utime + offset_us, max_pose_gap_us);
       if (!camera_pose) return false;
       const Eigen::Isometry3d sensor_from_world = (*camera_pose * body_from_sensor).inverse();
       const std::optional<ImageBox> image = ProjectToImage(

@@ -86,6 +86,16 @@ TEST_F(EvalCliTest, HelpAndBadOptions) {
   EXPECT_NE(out.find("--kitti-calib"), std::string::npos) << out;
   EXPECT_EQ(RunTool({run_, "--kitti-dontcare", dir_ + "/labels.txt"}, &out), 2);
   EXPECT_NE(out.find("--kitti-dontcare needs --region-camera"), std::string::npos) << out;
+  // A missing label file, and a DontCare box whose corners are swapped: refused, named.
+  const std::string calib = WriteAxisPermutationCalib(dir_ + "/calib_bad.txt");
+  EXPECT_EQ(RunTool({run_, tracks_, "--region-camera", "--kitti-calib", calib, "--kitti-dontcare",
+                     dir_ + "/no_labels.txt"}, &out), 2);
+  EXPECT_NE(out.find("no_labels.txt"), std::string::npos) << out;
+  const std::string swapped = dir_ + "/swapped.txt";
+  std::ofstream(swapped) << "0 -1 DontCare -1 -1 -10 300 100 200 200 -1 -1 -1 -1000 -1000 -1000 -10\n";
+  EXPECT_EQ(RunTool({run_, tracks_, "--region-camera", "--kitti-calib", calib, "--kitti-dontcare",
+                     swapped}, &out), 2);
+  EXPECT_NE(out.find("swapped.txt:1: DontCare box with x2 < x1"), std::string::npos) << out;
   EXPECT_EQ(RunTool({dir_ + "/missing.lcm"}, &out), 1);
   EXPECT_NE(out.find("missing.lcm"), std::string::npos) << out;
   EXPECT_EQ(RunTool({run_}, &out), 1);  // no tracks in it

@@ -244,6 +244,36 @@ TEST_F(EvaluatorTest, KittiDontCareRegionsDropUnmatchedTracksMostlyInside) {
   EXPECT_EQ(all.clear.true_positives, base.clear.true_positives);
   EXPECT_EQ(all.clear.false_positives, 0);
   EXPECT_GE(all.dont_care_track_detections, vtrack::testing::kScans);
+  // The camera is placed where the ego was at the truth's time (truth_time_offset_s after the
+  // scan), as the track is advanced to it. Ego poses: at the origin at each scan, 3 m to the
+  // left (+y) half a scan later; the truth is 50 ms after the scan. Seen from (0, 3) track 99's
+  // corners (y in +-0.9) project to u = 600 + 500 (3 - y) / x: u in [600 + 500 * 2.1 / 22.25,
+  // 600 + 500 * 3.9 / 17.75] = [647.19, 709.86].
+  {
+    LogData shifted = data;
+    shifted.poses.Clear();
+    for (int k = -1; k <= vtrack::testing::kScans; ++k) {
+      const std::int64_t t = vtrack::testing::kUtime0 + k * vtrack::testing::kScanPeriodUs;
+      Eigen::Isometry3d left = Eigen::Isometry3d::Identity();
+      left.translation() = Eigen::Vector3d(0.0, 3.0, 0.0);
+      shifted.poses.Add(t, Eigen::Isometry3d::Identity());
+      shifted.poses.Add(t + vtrack::testing::kScanPeriodUs / 2, left);
+    }
+    EvalParams p = params;
+    p.truth_time_offset_s = 0.05;
+    DontCareRegions dc;
+    dc.camera.rect_from_sensor = cam.rect_from_sensor;
+    dc.camera.P = cam.P;
+    dc.camera.image_width = 1200;
+    dc.camera.image_height = 360;
+    const double s0 = 600.0 + 500.0 * 2.1 / 22.25, s1 = 600.0 + 500.0 * 3.9 / 17.75;
+    for (int k = 0; k < vtrack::testing::kScans; ++k) dc.boxes[k].push_back({s0 - 1.0, 170.0, s1 + 1.0, 240.0});
+    p.dont_care = dc;
+    EXPECT_EQ(Evaluate(shifted, p).dont_care_track_detections, vtrack::testing::kScans);
+    // The region where the box would be from the pose at the scan's time: no longer over it.
+    for (auto& [k, regions] : p.dont_care->boxes) regions = {{u0 - 1.0, 170.0, u1 + 1.0, 240.0}};
+    EXPECT_EQ(Evaluate(shifted, p).dont_care_track_detections, 0);
+  }
   // Without the camera region it cannot be placed: refused.
   EvalParams bad;
   bad.dont_care = DontCareRegions{};

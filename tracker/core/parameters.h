@@ -665,6 +665,20 @@ struct EvidenceParams {
   bool Validate(std::string* error) const { return param::Validate(*this, error); }
 };
 
+struct ComputeParams {
+  static constexpr const char* kSection = "compute";
+  static constexpr const char* kAbout =
+      "Threads of the per-scan pipeline: TRACKS do not depend on them, only the latency does";
+  int threads = 2;
+
+  template <class V>
+  void Visit(V& v) {
+    using namespace param;
+    v("threads", &threads, {"-", Closed(1, 64), "threads that update a scan's tracks at once (each track's update is independent of the others'); 1: all on the calling thread. 2 on a 2-core computer: KITTI 0000 bench, see docs/results.md"});
+  }
+  bool Validate(std::string* error) const { return param::Validate(*this, error); }
+};
+
 struct TrackerParams {
   InputParams input;
   PreprocessParams preprocess;
@@ -681,6 +695,7 @@ struct TrackerParams {
   TrackManagerParams manager;  // includes the mode (mht | ism | vasm | cv)
   DetectionParams detections;  // a detector's boxes: the input mode and their measurement model
   EvidenceParams evidence;     // vehicle evidence of each track
+  ComputeParams compute;       // threads
 
   // Calls v(&section) for every component, in the order of config/tracker.yaml.
   template <class V>
@@ -700,6 +715,7 @@ struct TrackerParams {
     v(&manager);
     v(&detections);
     v(&evidence);
+    v(&compute);
   }
 
   // True if every component is valid; otherwise false and *error names the key and its value.

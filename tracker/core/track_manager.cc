@@ -100,7 +100,9 @@ void TrackManager::Predict(std::int64_t utime, std::vector<PredictedObject>* out
 
 void TrackManager::Update(std::size_t index, const PointSet& points,
                           const Eigen::Vector2d& sensor_xy, std::uint64_t seed,
-                          TrackDebug* debug, const RangeProfile* profile) {
+                          TrackDebug* debug, const RangeProfile* profile,
+                          TrackMeasurer* measurer) {
+  if (measurer == nullptr) measurer = &measurer_;
   Track& t = tracks_[index];
   const std::int64_t tm = std::max(points.mean_utime, t.state_utime);
   const double dt = static_cast<double>(tm - t.state_utime) * 1e-6;
@@ -110,19 +112,19 @@ void TrackManager::Update(std::size_t index, const PointSet& points,
   }
   t.state_utime = tm;
   if (t.small_object && points.extent >= params_.small_object_grown_extent) {
-    GrowIntoRectangle(points, sensor_xy, seed, &t);
+    GrowIntoRectangle(points, sensor_xy, seed, measurer, &t);
   }
-  const bool any = UpdateHypotheses(points, sensor_xy, seed, tm, &t);
+  const bool any = UpdateHypotheses(points, sensor_xy, seed, tm, measurer, &t);
   AfterUpdate(any, tm, /*pose_measured=*/false, &t);
   if (any && !t.mover && !t.small_object && profile && !profile->empty()) {
-    AlignToFullFace(ekf_, params_, points, sensor_xy, seed, *profile, &measurer_, &t);
+    AlignToFullFace(ekf_, params_, points, sensor_xy, seed, *profile, measurer, &t);
   }
   if (any && !t.mover && !t.small_object && !t.axis_from_full_face) AlignToShape(ekf_, params_, &t);
   if (debug) FillDebug(t, points, sensor_xy, debug);
 }
 
 void TrackManager::GrowIntoRectangle(const PointSet& points, const Eigen::Vector2d& sensor_xy,
-                                     std::uint64_t seed, Track* t) {
+                                     std::uint64_t seed, TrackMeasurer* measurer, Track* t) {
   // A far object first seen as a few returns has grown into a rectangle: its orientation was
   // never measured (centroid updates), so it is taken afresh from this fit, keeping the centre
   // velocity; the shape starts over. Its hypotheses reduce to the first one. Fitted as a
@@ -135,7 +137,7 @@ void TrackManager::GrowIntoRectangle(const PointSet& points, const Eigen::Vector
   fresh.noise_scale = h0.noise_scale;
   CentreMeasurement m;
   const bool fitted =
-      measurer_.Measure(false, points, sensor_xy, seed, std::nullopt, std::nullopt, &fresh, &m) &&
+      measurer->Measure(false, points, sensor_xy, seed, std::nullopt, std::nullopt, &fresh, &m) &&
       m.z.allFinite();
   if (!fitted) return;  // a small object until a fit succeeds
   t->small_object = false;
@@ -160,7 +162,8 @@ void TrackManager::GrowIntoRectangle(const PointSet& points, const Eigen::Vector
 }
 
 bool TrackManager::UpdateHypotheses(const PointSet& points, const Eigen::Vector2d& sensor_xy,
-                                    std::uint64_t seed, std::int64_t utime, Track* t) {
+                                    std::uint64_t seed, std::int64_t utime,
+                                    TrackMeasurer* measurer, Track* t) {
   // A parked car's partial face is placed along itself where predicted (FitRequest::
   // predicted_center). Not a mover's: the same view of a mover does not repeat scan after scan,
   // and placing its face where predicted loses it (KITTI 0000, every mode).
@@ -168,21 +171,21 @@ bool TrackManager::UpdateHypotheses(const PointSet& points, const Eigen::Vector2
   const double time_s = static_cast<double>(utime) * 1e-6;
   bool any = false;
   for (TrackHypothesis& h : t->hyps) {
-    any = UpdateHypothesis(*t, parked, points, sensor_xy, seed, time_s, &h) || any;
+    any = UpdateHypothesis(*t, parked, points, sensor_xy, seed, time_s, measurer, &h) || any;
   }
   return any;
 }
 
 bool TrackManager::UpdateHypothesis(const Track& t, bool parked, const PointSet& points,
                                     const Eigen::Vector2d& sensor_xy, std::uint64_t seed,
-                                    double time_s, TrackHypothesis* h) {
+                                    double time_s, TrackMeasurer* measurer, TrackHypothesis* h) {
   h->updated_this_scan = false;
   const Eigen::Vector3d pose = PoseOf(ekf_.model(h->filter.kind), h->filter.x);
   CentreMeasurement m;
   // Same request for every hypothesis but the heading and the shape: the seed is shared so
   // hypotheses that agree get the same fit.
   const bool measured =
-      measurer_.Measure(t.small_object, points, sensor_xy, seed, pose(2),
+      measurer->Measure(t.small_object, points, sensor_xy, seed, pose(2),
                         parked ? std::optional<Eigen::Vector2d>(pose.head<2>()) : std::nullopt,
                         h, &m);
   if (ApplyMeasurement(measured ? &m : nullptr, h)) ObserveShape(t.small_object, points, time_s, h);

@@ -104,8 +104,14 @@ class TrackManager {
 
   // Updates track index with its returns; debug (optional) is filled for the scan's debug.
   // profile (optional): the scan's nearest range per bearing, for the full-view test of faces.
+  // measurer (optional): the fitter to use (its buffers are scratch); updates of different
+  // tracks may run at once on different threads, each with its own (NewMeasurer), and give the
+  // same results as one after the other.
   void Update(std::size_t index, const PointSet& points, const Eigen::Vector2d& sensor_xy,
-              std::uint64_t seed, TrackDebug* debug, const RangeProfile* profile = nullptr);
+              std::uint64_t seed, TrackDebug* debug, const RangeProfile* profile = nullptr,
+              TrackMeasurer* measurer = nullptr);
+  // A fitter like the one Update uses by default, for another thread's updates.
+  TrackMeasurer NewMeasurer() const { return measurer_; }
   // The reported rectangle of a track at its state time.
   OrientedBox Box(std::size_t index) const;
   // Updates track index with a detector's box (detections.h).
@@ -147,13 +153,13 @@ class TrackManager {
   OrientedBox RectangleOf(const Track& t, const Hypothesis& h) const;
   // A small object whose returns have grown to small_object_grown_extent becomes a rectangle.
   void GrowIntoRectangle(const PointSet& points, const Eigen::Vector2d& sensor_xy,
-                         std::uint64_t seed, Track* t);
+                         std::uint64_t seed, TrackMeasurer* measurer, Track* t);
   // Measures and updates every hypothesis; true if any accepted its measurement.
   bool UpdateHypotheses(const PointSet& points, const Eigen::Vector2d& sensor_xy,
-                        std::uint64_t seed, std::int64_t utime, Track* t);
+                        std::uint64_t seed, std::int64_t utime, TrackMeasurer* measurer, Track* t);
   bool UpdateHypothesis(const Track& t, bool parked, const PointSet& points,
                         const Eigen::Vector2d& sensor_xy, std::uint64_t seed, double time_s,
-                        TrackHypothesis* h);
+                        TrackMeasurer* measurer, TrackHypothesis* h);
   // The shape estimate's observations after an accepted update, and on creation.
   void ObserveShape(bool small, const PointSet& points, double time_s, TrackHypothesis* h) const;
   void ObserveFirstShape(bool small, const PointSet& points, TrackHypothesis* h) const;

@@ -118,9 +118,30 @@ class Tracker {
   void CreateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_xy, ScanOutput* out);
   // The segment of every return and each segment's extent (for the vehicle evidence).
   void IndexSegments();
-  // The vehicle evidence of track index from its returns idx on this scan.
-  void ObserveEvidence(std::size_t index, const std::vector<std::int32_t>& idx,
-                       const Eigen::Vector2d& sensor_xy, bool three_d, ScanOutput* out);
+  // What one thread of UpdateTracks (and CreateTracks: the first) works with.
+  struct Worker {
+    Worker(const OutlineParams& outline_params, TrackMeasurer m)
+        : outline(outline_params), measurer(std::move(m)) {}
+    OutlineExtractor outline;
+    PointSet point_set;
+    TrackMeasurer measurer;
+    std::vector<float> evidence_scratch;
+  };
+  // What the update of one track adds to the scan's output (kept per track so that the
+  // output's order does not depend on the threads).
+  struct TrackUpdateOutput {
+    bool has_debug = false, has_evidence = false;
+    TrackDebug debug;
+    ScanOutput::EvidenceRow evidence;
+  };
+  // Updates track j with its returns of this scan (or misses it) on worker w.
+  void UpdateTrack(std::size_t j, const LadarScan& scan, const Eigen::Vector2d& sensor_xy,
+                   bool multi_ring, Worker* w, TrackUpdateOutput* out);
+  // The vehicle evidence of track index from its returns idx on this scan; the row in *row if
+  // evidence recording is on (true then).
+  bool ObserveEvidence(std::size_t index, const std::vector<std::int32_t>& idx,
+                       const Eigen::Vector2d& sensor_xy, bool three_d, Worker* w,
+                       ScanOutput::EvidenceRow* row);
 
   TrackerParams params_;
   bool debug_;
@@ -131,21 +152,20 @@ class Tracker {
   Preprocessor preprocessor_;
   Segmenter segmenter_;
   Associator associator_;
-  OutlineExtractor outline_;
   CreatedRectangles created_;
+  std::vector<Worker> workers_;  // compute.threads of them
 
   // Scratch reused from scan to scan.
   WorldPoints points_;
   Segments segments_;
   std::vector<PredictedObject> predicted_;
   AssociationResult association_;
-  PointSet point_set_;
+  std::vector<TrackUpdateOutput> update_out_;  // per track of the scan being processed
   RangeProfile profile_;  // nearest return per bearing of the scan being processed
   std::vector<char> unobserved_;  // per track: in a lost wedge of the scan being processed
   std::vector<AzimuthWedge> lost_world_;  // the scan's lost wedges as world bearings [rad]
   std::vector<std::int32_t> segment_of_;  // per return of points_: its segment, or -1
   std::vector<float> segment_extent_;     // [m] per segment: bounding-box diagonal
-  std::vector<float> evidence_scratch_;
   int top_ring_ = -1;                     // TopRing of the scan being processed
   bool record_evidence_ = false;
   std::int64_t returns_processed_ = 0;

@@ -6,11 +6,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <random>
 #include <set>
+#include <string>
 
 #include "tests/tracker/core/synthetic_scene.h"
 
@@ -274,6 +276,64 @@ TEST(TrackerTest, SameInputGivesIdenticalOutput) {
       EXPECT_EQ(a[i].tracks[j].id, b[i].tracks[j].id);
       EXPECT_EQ(a[i].tracks[j].x, b[i].tracks[j].x);  // bit for bit
       EXPECT_EQ(a[i].tracks[j].theta, b[i].tracks[j].theta);
+    }
+  }
+}
+
+TEST(TrackerTest, AnyNumberOfThreadsGivesTheSameOutput) {
+  // compute.threads shares the scan's track updates among threads: the tracks, the debug output
+  // and the evidence rows must be those of one thread, in the same order. Fourteen objects (a
+  // row of parked cars on either side, two movers) give the threads tracks to share.
+  std::vector<SceneObject> objects = TwoCars();
+  for (int k = 0; k < 6; ++k) {
+    objects.push_back({10 + k, AckermannPath({-10.0 + 7.0 * k, 14.0}, 0.0, 0.0, 0.0, -1.4)});
+    objects.push_back({20 + k, AckermannPath({-8.0 + 7.0 * k, -16.0}, 0.05, 0.0, 0.0, -1.4)});
+  }
+  auto run = [&objects](int threads) {
+    SyntheticScene scene(SceneConfig{}, objects, 45);
+    TrackerParams params;
+    params.compute.threads = threads;
+    Tracker tracker(params, /*debug=*/true);
+    tracker.SetRecordEvidence(true);
+    return RunScene(&tracker, &scene, 3.0);
+  };
+  const std::vector<ScanOutput> one = run(1);
+  std::size_t max_tracks = 0;
+  for (const ScanOutput& o : one) max_tracks = std::max(max_tracks, o.tracks.size());
+  ASSERT_GE(max_tracks, 10u) << "the scene should give the threads many tracks to share";
+  for (const int threads : {2, 3}) {
+    SCOPED_TRACE("threads " + std::to_string(threads));
+    const std::vector<ScanOutput> many = run(threads);
+    ASSERT_EQ(one.size(), many.size());
+    for (std::size_t i = 0; i < one.size(); ++i) {
+      const ScanOutput& a = one[i];
+      const ScanOutput& b = many[i];
+      ASSERT_EQ(a.tracks.size(), b.tracks.size()) << "scan " << i;
+      for (std::size_t j = 0; j < a.tracks.size(); ++j) {
+        const TrackReport& ta = a.tracks[j];
+        const TrackReport& tb = b.tracks[j];
+        EXPECT_EQ(ta.id, tb.id);  // bit for bit below
+        EXPECT_EQ(ta.x, tb.x);
+        EXPECT_EQ(ta.y, tb.y);
+        EXPECT_EQ(ta.theta, tb.theta);
+        EXPECT_EQ(ta.speed, tb.speed);
+        EXPECT_EQ(ta.length, tb.length);
+        EXPECT_EQ(ta.num_hypotheses, tb.num_hypotheses);
+        EXPECT_EQ(ta.object_class, tb.object_class);
+        EXPECT_EQ(ta.vehicle_probability, tb.vehicle_probability);
+        EXPECT_EQ(ta.cov, tb.cov);
+      }
+      ASSERT_EQ(a.debug.size(), b.debug.size()) << "scan " << i;
+      for (std::size_t j = 0; j < a.debug.size(); ++j) {
+        EXPECT_EQ(a.debug[j].track_id, b.debug[j].track_id);
+        EXPECT_EQ(a.debug[j].point_x, b.debug[j].point_x);
+      }
+      ASSERT_EQ(a.evidence.size(), b.evidence.size()) << "scan " << i;
+      for (std::size_t j = 0; j < a.evidence.size(); ++j) {
+        EXPECT_EQ(a.evidence[j].track_id, b.evidence[j].track_id);
+        EXPECT_EQ(a.evidence[j].logit, b.evidence[j].logit);
+        EXPECT_EQ(a.evidence[j].log_odds, b.evidence[j].log_odds);
+      }
     }
   }
 }

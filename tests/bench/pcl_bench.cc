@@ -14,8 +14,20 @@
 // Agreement (counters of BM_Segmentation_PclEuclidean): the adjusted Rand index of the two
 // partitions over the returns both keep (1 = identical, 0 = chance), and the share of the
 // tracker's segments whose returns' majority PCL cluster covers them with IoU >= 0.5.
+//
+// Whole pipelines on the same raw sweeps (frames 11-40, the sensor's returns as recorded), one
+// thread, CPU time per sweep:
+//  - BM_Pipeline_PclVoxelEuclidean: what a PCL user would build to find objects: VoxelGrid
+//    (0.2 m leaves), the ground cut by a PassThrough on height (kept: 0.3-3 m above the road,
+//    KITTI's sensor is 1.73 m above it), Euclidean cluster extraction (0.5 m, >= 10 returns);
+//    no tracking, no ego-motion compensation;
+//  - BM_Pipeline_VtrackTracker: vtrack's whole tracker (Tracker::AddScan: compensation, ground,
+//    segmentation, association, fits, filters, hypotheses, evidence, report), after 10 frames
+//    of warm-up.
 #include <benchmark/benchmark.h>
 
+#include <pcl/filters/passthrough.h>
+#include <pcl/filters/voxel_grid.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 #include <pcl/search/kdtree.h>
@@ -24,6 +36,7 @@
 #include <time.h>
 
 #include <cstdint>
+#include <memory>
 #include <unordered_map>
 #include <vector>
 
@@ -193,6 +206,103 @@ void BM_Segmentation_PclEuclidean(benchmark::State& state) {
   state.counters["segments_matched"] = evaluated > 0 ? matched_sum / evaluated : 0.0;
 }
 BENCHMARK(BM_Segmentation_PclEuclidean)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(30);
+
+// KITTI's frames as raw PCL clouds (sensor frame, every return), for the PCL pipeline.
+const std::vector<pcl::PointCloud<pcl::PointXYZ>::Ptr>& RawClouds() {
+  static const std::vector<pcl::PointCloud<pcl::PointXYZ>::Ptr> clouds = [] {
+    std::vector<pcl::PointCloud<pcl::PointXYZ>::Ptr> v;
+    const bench::Sequence& seq = bench::Kitti();
+    for (std::size_t i = 10; seq.error.empty() && i < std::min<std::size_t>(40, seq.scans.size()); ++i) {
+      const LadarScan& scan = seq.scans[i];
+      pcl::PointCloud<pcl::PointXYZ>::Ptr c(new pcl::PointCloud<pcl::PointXYZ>);
+      c->reserve(scan.size());
+      for (std::size_t k = 0; k < scan.size(); ++k) c->push_back(pcl::PointXYZ(scan.x[k], scan.y[k], scan.z[k]));
+      v.push_back(std::move(c));
+    }
+    return v;
+  }();
+  return clouds;
+}
+
+void BM_Pipeline_PclVoxelEuclidean(benchmark::State& state) {
+  const auto& clouds = RawClouds();
+  if (clouds.empty()) {
+    state.SkipWithError(bench::Kitti().error.c_str());
+    return;
+  }
+  constexpr float kLeaf = 0.2f, kTolerance = 0.5f;  // [m]
+  constexpr float kSensorHeight = 1.73f;            // [m] KITTI's Velodyne above the road
+  std::size_t i = 0;
+  double clusters = 0, voxels = 0;
+  pcl::PointCloud<pcl::PointXYZ>::Ptr down(new pcl::PointCloud<pcl::PointXYZ>);
+  pcl::PointCloud<pcl::PointXYZ>::Ptr above(new pcl::PointCloud<pcl::PointXYZ>);
+  std::vector<pcl::PointIndices> found;
+  for (auto _ : state) {
+    const double c0 = ThreadCpuSeconds();
+    pcl::VoxelGrid<pcl::PointXYZ> grid;
+    grid.setInputCloud(clouds[i]);
+    grid.setLeafSize(kLeaf, kLeaf, kLeaf);
+    grid.filter(*down);
+    pcl::PassThrough<pcl::PointXYZ> cut;
+    cut.setInputCloud(down);
+    cut.setFilterFieldName("z");
+    cut.setFilterLimits(0.3f - kSensorHeight, 3.0f - kSensorHeight);
+    cut.filter(*above);
+    pcl::search::KdTree<pcl::PointXYZ>::Ptr tree(new pcl::search::KdTree<pcl::PointXYZ>);
+    tree->setInputCloud(above);
+    pcl::EuclideanClusterExtraction<pcl::PointXYZ> ec;
+    ec.setClusterTolerance(kTolerance);
+    ec.setMinClusterSize(10);
+    ec.setMaxClusterSize(std::numeric_limits<int>::max());
+    ec.setSearchMethod(tree);
+    ec.setInputCloud(above);
+    found.clear();
+    ec.extract(found);
+    state.SetIterationTime(ThreadCpuSeconds() - c0);
+    clusters += static_cast<double>(found.size());
+    voxels += static_cast<double>(down->size());
+    i = (i + 1) % clouds.size();
+  }
+  state.counters["clusters"] = benchmark::Counter(clusters, benchmark::Counter::kAvgIterations);
+  state.counters["voxels"] = benchmark::Counter(voxels, benchmark::Counter::kAvgIterations);
+}
+BENCHMARK(BM_Pipeline_PclVoxelEuclidean)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(30);
+
+void BM_Pipeline_VtrackTracker(benchmark::State& state) {
+  const bench::Sequence& seq = bench::Kitti();
+  if (!seq.error.empty() || seq.scans.size() < 40) {
+    state.SkipWithError(seq.error.empty() ? "sequence too short" : seq.error.c_str());
+    return;
+  }
+  TrackerParams params = bench::ShippedParams();
+  params.compute.threads = 1;
+  std::unique_ptr<Tracker> tracker;
+  std::vector<ScanOutput> out;
+  std::size_t i = 40;
+  double tracks = 0;
+  for (auto _ : state) {
+    if (i >= 40) {  // the same 30 frames each round, after the same warm-up
+      state.PauseTiming();
+      tracker = std::make_unique<Tracker>(params);
+      for (i = 0; i < 10; ++i) {
+        for (const auto& p : seq.poses_before[i]) tracker->AddPose(p, &out);
+        LadarScan copy = seq.scans[i];
+        tracker->AddScan(std::move(copy), &out);
+      }
+      state.ResumeTiming();
+    }
+    for (const auto& p : seq.poses_before[i]) tracker->AddPose(p, &out);
+    LadarScan copy = seq.scans[i];
+    out.clear();
+    const double c0 = ThreadCpuSeconds();
+    tracker->AddScan(std::move(copy), &out);
+    state.SetIterationTime(ThreadCpuSeconds() - c0);
+    if (!out.empty()) tracks += static_cast<double>(out.back().tracks.size());
+    ++i;
+  }
+  state.counters["tracks"] = benchmark::Counter(tracks, benchmark::Counter::kAvgIterations);
+}
+BENCHMARK(BM_Pipeline_VtrackTracker)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(30);
 
 }  // namespace
 

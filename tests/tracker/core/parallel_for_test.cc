@@ -1,0 +1,69 @@
+// ParallelFor: every index is called exactly once whatever the number of threads, the calls do
+// run on more than one thread when asked, and an exception of one call reaches the caller.
+#include "tracker/core/parallel_for.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <mutex>
+#include <set>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+namespace vtrack {
+namespace {
+
+TEST(ParallelFor, CallsEveryIndexOnceWithAWorkerBelowTheThreadCount) {
+  for (const int threads : {1, 2, 3, 8}) {
+    for (const std::size_t n : {0u, 1u, 2u, 5u, 1000u}) {
+      std::vector<std::atomic<int>> calls(n);
+      std::atomic<int> bad_worker{0};
+      ParallelFor(n, threads, [&](std::size_t i, int worker) {
+        calls[i].fetch_add(1);
+        if (worker < 0 || worker >= threads) bad_worker.fetch_add(1);
+      });
+      for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(calls[i].load(), 1) << "index " << i;
+      EXPECT_EQ(bad_worker.load(), 0);
+    }
+  }
+}
+
+TEST(ParallelFor, RunsOnMoreThanOneThreadWhenAsked) {
+  // Each call waits until another thread has started one (or 0.2 s pass): with one thread the
+  // waits time out, with two they do not.
+  auto threads_seen = [](int threads) {
+    std::mutex m;
+    std::set<std::thread::id> ids;
+    std::atomic<int> started{0};
+    ParallelFor(8, threads, [&](std::size_t, int) {
+      {
+        std::lock_guard<std::mutex> lock(m);
+        ids.insert(std::this_thread::get_id());
+      }
+      started.fetch_add(1);
+      const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(200);
+      while (started.load() < 2 && std::chrono::steady_clock::now() < until) std::this_thread::yield();
+    });
+    return ids.size();
+  };
+  EXPECT_EQ(threads_seen(1), 1u);
+  EXPECT_EQ(threads_seen(2), 2u);
+}
+
+TEST(ParallelFor, AnExceptionOfOneCallReachesTheCaller) {
+  for (const int threads : {1, 2}) {
+    std::atomic<int> calls{0};
+    EXPECT_THROW(ParallelFor(100, threads,
+                             [&](std::size_t i, int) {
+                               calls.fetch_add(1);
+                               if (i == 7) throw std::runtime_error("index 7");
+                             }),
+                 std::runtime_error);
+    EXPECT_GE(calls.load(), 8);
+  }
+}
+
+}  // namespace
+}  // namespace vtrack

@@ -163,7 +163,7 @@ class ValueText {
 
 // The valid values of a field as the reference shows them; for a list, those of its items' keys.
 template <class T>
-std::string ValidText(T* value, const param::Info& info) {
+std::string ValidText([[maybe_unused]] T* value, const param::Info& info) {
   if constexpr (std::is_enum_v<T>) {
     return Choices<T>();
   } else if constexpr (std::is_arithmetic_v<T>) {

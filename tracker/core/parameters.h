@@ -571,12 +571,14 @@ enum class EvidenceFeature : std::int8_t {
   kTopBeam,        // [-] ln(1 + returns from the scan's highest beam): the object reaches above
                    //     what that beam sees at its range (a tree or a wall close by looks no
                    //     taller than the beam; a car stays under it; 3-D)
-  kLength,         // [m] the shape estimate of the reported hypothesis (0 if none)
-  kWidth,          // [m]
+  kLength,         // [m] the shape estimate of the reported hypothesis; missing (NaN) if none
+  kWidth,          // [m] likewise: a single edge seen so far measures no width
   kSegmentExtent,  // [m] bounding-box diagonal of the largest segment holding the returns (walls)
   kSpeed,          // [m/s] of the reported hypothesis' centre
   kMover,          // [-] 1 if judged a mover
   kSmall,          // [-] 1 if measured by its centroid (small object)
+  kLengthUnseen,   // [-] 1 if the hypothesis has no length estimate yet
+  kWidthUnseen,    // [-] 1 if it has no width estimate yet (one face seen)
   kCount
 };
 
@@ -586,12 +588,14 @@ template <>
 struct vtrack::EnumNames<vtrack::EvidenceFeature> {
   static constexpr std::array kNames{"log_points", "log_range", "height_max", "height_median",
                                      "height_min", "column_top", "top_beam", "length", "width",
-                                     "segment_extent", "speed", "mover", "small"};
+                                     "segment_extent", "speed", "mover", "small",
+                                     "length_unseen", "width_unseen"};
 };
 
 namespace vtrack {
 
-// One term of the per-scan logit: weight * ((feature - center) / scale)^power.
+// One term of the per-scan logit: weight * ((feature - center) / scale)^power; 0 while the
+// feature is missing (not finite), as if it were at its training mean.
 struct EvidenceTerm {
   EvidenceFeature feature = EvidenceFeature::kLogPoints;
   int power = 1;

@@ -98,8 +98,13 @@ EvidenceFeatures FeaturesOf(const ReturnEvidence& r, const Track& t, double spee
   set(EvidenceFeature::kHeightMin, r.height_min);
   set(EvidenceFeature::kColumnTop, r.column_top);
   set(EvidenceFeature::kTopBeam, std::log1p(static_cast<double>(r.top_beam)));
-  set(EvidenceFeature::kLength, sel.length_est.value_or(0.0));
-  set(EvidenceFeature::kWidth, sel.width_est.value_or(0.0));
+  // A dimension not estimated yet is missing, not 0: a single face seen says nothing of the
+  // width, and 0 would read as a very narrow object. Its own indicator carries the fact.
+  constexpr double kMissing = std::numeric_limits<double>::quiet_NaN();
+  set(EvidenceFeature::kLength, sel.length_est.value_or(kMissing));
+  set(EvidenceFeature::kWidth, sel.width_est.value_or(kMissing));
+  set(EvidenceFeature::kLengthUnseen, sel.length_est ? 0.0 : 1.0);
+  set(EvidenceFeature::kWidthUnseen, sel.width_est ? 0.0 : 1.0);
   set(EvidenceFeature::kSegmentExtent, r.segment_extent);
   // Speed from the reported hypothesis (bounded: a diverging filter says nothing more at 60 m/s).
   set(EvidenceFeature::kSpeed, std::isfinite(speed) ? std::min(30.0, std::abs(speed)) : 0.0);
@@ -111,7 +116,9 @@ EvidenceFeatures FeaturesOf(const ReturnEvidence& r, const Track& t, double spee
 double ScanLogit(const EvidenceParams& p, bool three_d, const EvidenceFeatures& f) {
   double l = three_d ? p.bias_3d : p.bias_2d;
   for (const EvidenceTerm& term : three_d ? p.terms_3d : p.terms_2d) {
-    const double z = (f[static_cast<std::size_t>(term.feature)] - term.center) / term.scale;
+    const double v = f[static_cast<std::size_t>(term.feature)];
+    if (!std::isfinite(v)) continue;  // missing: at the training mean, z = 0
+    const double z = (v - term.center) / term.scale;
     l += term.weight * (term.power == 2 ? z * z : z);
   }
   return l;

@@ -6,6 +6,8 @@
 // high their columns reach (crowns and building fronts above max_height), the extent of the
 // segment they belong to, and the track's own footprint and motion. A logistic model gives the scan's log posterior odds at the fitting set's prior pi,
 //   l(f) = bias + sum_k w_k ((f_k - c_k) / s_k)^p_k,
+// where a missing feature (a length or width not estimated yet: NaN) adds nothing, i.e. sits at
+// its training mean c_k, and an indicator feature says that it is missing;
 // one model for 3-D clouds and one for single-plane scans (which measure no heights). The
 // track's log-odds L start at logit(pi); each scan moves them by scan_weight a, either adding
 // its log-likelihood ratio (accumulation: sum) or moving towards its log posterior odds

@@ -59,6 +59,36 @@ TEST(VehicleEvidence, LogitIsTheSumOfItsTermsAndAccumulationIsDiscountedAndClamp
   EXPECT_NEAR(VehicleProbability(std::log(3.0)), 0.75, 1e-12);
 }
 
+// A dimension not estimated yet is missing: its terms add nothing (as at the training mean),
+// and its indicator is 1. A 0 in its place would read as a 0 m wide object.
+TEST(VehicleEvidence, AnUnestimatedDimensionIsMissingNotZero) {
+  EvidenceParams p;
+  p.bias_2d = -1.0;
+  p.terms_2d = {{EvidenceFeature::kWidth, 1, 1.5, 0.5, 2.0},
+                {EvidenceFeature::kWidth, 2, 1.5, 0.5, -3.0},
+                {EvidenceFeature::kLength, 1, 4.0, 2.0, 1.0},
+                {EvidenceFeature::kWidthUnseen, 1, 0.25, 0.5, -0.5}};
+  Track t;
+  t.hyps.resize(1);
+  t.selected = 0;
+  t.hyps[0].length_est = 5.0;  // one face seen: a length, no width
+  ReturnEvidence r;
+  r.num_points = 12;
+  r.range = 20.0;
+  EvidenceFeatures f = FeaturesOf(r, t, 0.0);
+  EXPECT_TRUE(std::isnan(f[static_cast<std::size_t>(EvidenceFeature::kWidth)]));
+  EXPECT_EQ(f[static_cast<std::size_t>(EvidenceFeature::kWidthUnseen)], 1.0);
+  EXPECT_EQ(f[static_cast<std::size_t>(EvidenceFeature::kLengthUnseen)], 0.0);
+  EXPECT_EQ(f[static_cast<std::size_t>(EvidenceFeature::kLength)], 5.0);
+  // bias + length z = 0.5 + indicator z = 1.5; both width terms absent.
+  EXPECT_NEAR(ScanLogit(p, false, f), -1.0 + 0.5 - 0.75, 1e-12);
+
+  t.hyps[0].width_est = 2.0;  // the second face seen: z = 1, 2 * 1 - 3 * 1
+  f = FeaturesOf(r, t, 0.0);
+  EXPECT_EQ(f[static_cast<std::size_t>(EvidenceFeature::kWidthUnseen)], 0.0);
+  EXPECT_NEAR(ScanLogit(p, false, f), -1.0 + 2.0 - 3.0 + 0.5 + (-0.5) * (-0.5), 1e-12);
+}
+
 TEST(VehicleEvidence, ReturnsGiveTheirHeightProfileColumnTopRangeAndSegmentExtent) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> height(0.3f, 1.6f), xy(-1.0f, 1.0f);

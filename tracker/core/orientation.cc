@@ -7,16 +7,6 @@
 #include "base/angle.h"
 
 namespace vtrack {
-namespace {
-
-// A face's end is hidden if a return lies this much nearer than the end just beyond it.
-constexpr double kOccluderMargin = 0.5;  // [m]
-// Bearing bins looked at beyond each end of a face: 0.6 deg at the profile's 0.2 deg bins, the
-// spacing of a few azimuth steps of a 64-beam scanner.
-constexpr int kBinsBeyondEnd = 3;  // [-]
-
-}  // namespace
-
 void TurnAxis(const Ekf& ekf, ModelKind kind, int quarter_turns, TrackHypothesis* h) {
   h->filter = ekf.Convert(h->filter, kind, quarter_turns * 0.5 * kPi);
   if (std::abs(quarter_turns) % 2 == 1) {
@@ -108,8 +98,8 @@ void AlignToFullFace(const Ekf& ekf, const TrackManagerParams& params, const Poi
     if (extent >= params.vehicle_min_length || extent < 0.5 * params.vehicle_min_width) continue;
     // A corner's start is the corner itself (seen); an edge needs both ends free.
     const bool start_free = sel.fit.kind == FitKind::kCorner ||
-                            profile.FreeBeyond(a, b, kOccluderMargin, kBinsBeyondEnd);
-    if (!start_free || !profile.FreeBeyond(b, a, kOccluderMargin, kBinsBeyondEnd)) continue;
+                            profile.FreeBeyond(a, b, kEndOccluderMargin, kEndBinsBeyond);
+    if (!start_free || !profile.FreeBeyond(b, a, kEndOccluderMargin, kEndBinsBeyond)) continue;
     const double face_dir = std::atan2((b - a).y(), (b - a).x());
     const double theta = sel.filter.x(4);
     const bool along = std::abs(std::sin(AngleDiff(theta, face_dir))) < std::sin(DegToRad(45.0));

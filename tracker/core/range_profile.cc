@@ -9,6 +9,24 @@
 
 namespace vtrack {
 
+double MedianBearingStepDeg(const std::vector<float>& x, const std::vector<float>& y) {
+  std::vector<double> steps;
+  steps.reserve(x.size());
+  double prev = 0.0;
+  bool have_prev = false;
+  for (std::size_t i = 0; i < x.size() && i < y.size(); ++i) {
+    if (!std::isfinite(x[i]) || !std::isfinite(y[i])) continue;
+    const double a = std::atan2(y[i], x[i]);
+    if (have_prev) steps.push_back(std::abs(AngleDiff(a, prev)));
+    prev = a;
+    have_prev = true;
+  }
+  if (steps.empty()) return 0.0;
+  const auto mid = steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2);
+  std::nth_element(steps.begin(), mid, steps.end());
+  return RadToDeg(*mid);
+}
+
 void RangeProfile::Build(const Eigen::Vector2d& sensor_xy, const std::vector<double>& x,
                          const std::vector<double>& y, double bin_deg) {
   Build(sensor_xy, x, y, {}, bin_deg);

@@ -12,6 +12,18 @@ namespace vtrack {
 // The tracker's finest range-profile bearing bin: 7200 bins per ring.
 inline constexpr double kMinRangeProfileBinDeg = 0.05;  // [deg]
 
+// What FreeBeyond is asked for the end of a face or of a track's returns: a return this much
+// nearer than the end ...
+inline constexpr double kEndOccluderMargin = 0.5;  // [m]
+// ... in this many bearing bins beyond it hides it: 0.6 deg at the 3-D profile's 0.2 deg bins,
+// the spacing of a few azimuth steps of a 64-beam scanner.
+inline constexpr int kEndBinsBeyond = 3;  // [-]
+
+// The median bearing step [deg] between successive returns of a single-plane scan (sensor
+// frame, in scan order); 0 with fewer than two returns. A profile binned coarser than this
+// leaves no empty bins between the returns of one face.
+double MedianBearingStepDeg(const std::vector<float>& x, const std::vector<float>& y);
+
 // The nearest return per bearing bin around the sensor, over every return of a scan, per ring of
 // a 3-D scanner. It tells whether a fitted face ends where the object ends (free space, or only
 // farther returns, just beyond the end: a full view of that face) or where something nearer

@@ -242,12 +242,19 @@ void Tracker::UpdateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_
                            ScanOutput* out) {
   // 3-D clouds only: a single-plane scanner's bearing spacing (0.5 deg or more) leaves bins of
   // the profile empty between its returns, which would read as free space beyond a face's end.
+  // The vehicle evidence asks a single-plane scan's profile too, binned at 1.5 bearing steps so
+  // that no bin between the returns of one face is empty (hidden_ends); the orientation rules
+  // are given the 3-D profile only.
   const bool multi_ring = scan.num_rings > 1;
   if (multi_ring) {
     profile_.Build(sensor_xy, points_.x, points_.y, points_.ring,
                    std::max(kMinRangeProfileBinDeg, params_.outline.bin_deg));
-    for (const AzimuthWedge& w : lost_world_) profile_.MarkUnseen(w.begin, w.end);
+  } else {
+    const double step_deg = MedianBearingStepDeg(scan.x, scan.y);
+    profile_.Build(sensor_xy, points_.x, points_.y,
+                   std::max(kMinRangeProfileBinDeg, 1.5 * (step_deg > 0.0 ? step_deg : 1.0)));
   }
+  for (const AzimuthWedge& w : lost_world_) profile_.MarkUnseen(w.begin, w.end);
   const std::size_t num_tracks = manager_->tracks().size();
   // Each track's update touches that track only (and its worker's scratch): the tracks are
   // shared among the threads, and what they add to the output is appended in track order.
@@ -307,7 +314,7 @@ bool Tracker::ObserveEvidence(std::size_t index, const std::vector<std::int32_t>
                               ScanOutput::EvidenceRow* row) {
   const ReturnEvidence r =
       MeasureReturns(points_, idx, segment_of_, segment_extent_, sensor_xy, three_d, top_ring_,
-                     &w->evidence_scratch);
+                     &profile_, &w->evidence_scratch);
   row->logit = manager_->ObserveEvidence(index, r, record_evidence_ ? &row->features : nullptr);
   if (!record_evidence_) return false;
   const Track& t = manager_->tracks()[index];

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "tracker/core/preprocess.h"
+#include "tracker/core/range_profile.h"
 #include "tracker/core/scan.h"
 #include "tracker/core/track.h"
 
@@ -44,11 +45,39 @@ int TopRing(const LadarScan& scan) {
   return top;
 }
 
+int HiddenEnds(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
+               const Eigen::Vector2d& centroid, const Eigen::Vector2d& sensor_xy,
+               const RangeProfile& profile) {
+  // The extreme bearings about the centroid's: tan of the bearing offset, cross / dot, is
+  // monotonic in the offset within +-90 deg (a track's returns span far less), no atan2.
+  const Eigen::Vector2d c = centroid - sensor_xy;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  Eigen::Vector2d a = centroid, b = centroid;
+  for (const std::int32_t i : idx) {
+    const Eigen::Vector2d p(pts.x[static_cast<std::size_t>(i)], pts.y[static_cast<std::size_t>(i)]);
+    const Eigen::Vector2d v = p - sensor_xy;
+    const double dot = c.dot(v);
+    if (!(dot > 0.0)) continue;
+    const double t = (c.x() * v.y() - c.y() * v.x()) / dot;
+    if (t < lo) {
+      lo = t;
+      a = p;
+    }
+    if (t > hi) {
+      hi = t;
+      b = p;
+    }
+  }
+  if (!(hi > lo)) return 2;  // one bearing: no extent seen, no end free of the other
+  return (profile.FreeBeyond(a, b, kEndOccluderMargin, kEndBinsBeyond) ? 0 : 1) +
+         (profile.FreeBeyond(b, a, kEndOccluderMargin, kEndBinsBeyond) ? 0 : 1);
+}
+
 ReturnEvidence MeasureReturns(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
                               const std::vector<std::int32_t>& segment_of,
                               const std::vector<float>& segment_extent,
                               const Eigen::Vector2d& sensor_xy, bool three_d, int top_ring,
-                              std::vector<float>* scratch) {
+                              const RangeProfile* profile, std::vector<float>* scratch) {
   ReturnEvidence r;
   r.three_d = three_d;
   r.num_points = static_cast<int>(idx.size());
@@ -66,8 +95,12 @@ ReturnEvidence MeasureReturns(const WorldPoints& pts, const std::vector<std::int
     if (s >= 0) extent = std::max(extent, segment_extent[static_cast<std::size_t>(s)]);
   }
   const double n = static_cast<double>(idx.size());
-  r.range = (Eigen::Vector2d(sx / n, sy / n) - sensor_xy).norm();
+  const Eigen::Vector2d centroid(sx / n, sy / n);
+  r.range = (centroid - sensor_xy).norm();
   r.segment_extent = extent;
+  if (profile != nullptr && !profile->empty()) {
+    r.hidden_ends = HiddenEnds(pts, idx, centroid, sensor_xy, *profile);
+  }
   if (!three_d) return r;
   auto& h = *scratch;
   const auto half = static_cast<std::ptrdiff_t>(h.size() / 2);
@@ -106,6 +139,7 @@ EvidenceFeatures FeaturesOf(const ReturnEvidence& r, const Track& t, double spee
   set(EvidenceFeature::kLengthUnseen, sel.length_est ? 0.0 : 1.0);
   set(EvidenceFeature::kWidthUnseen, sel.width_est ? 0.0 : 1.0);
   set(EvidenceFeature::kSegmentExtent, r.segment_extent);
+  set(EvidenceFeature::kHiddenEnds, r.hidden_ends);
   // Speed from the reported hypothesis (bounded: a diverging filter says nothing more at 60 m/s).
   set(EvidenceFeature::kSpeed, std::isfinite(speed) ? std::min(30.0, std::abs(speed)) : 0.0);
   set(EvidenceFeature::kMover, t.mover ? 1.0 : 0.0);

@@ -21,6 +21,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -29,6 +30,7 @@
 
 namespace vtrack {
 
+class RangeProfile;
 struct LadarScan;
 struct Track;
 struct WorldPoints;
@@ -47,6 +49,10 @@ struct ReturnEvidence {
   double column_top = 0.0;       // [m] median of their cells' highest returns, at most 10 m
   int top_beam = 0;              // [-] of them from the scan's highest beam
   double segment_extent = 0.0;   // [m]
+  // [-] Ends of the returns (their extreme bearings from the sensor) that are not free: a nearer
+  // return just beyond hides the end, or the object goes on at the same range (a wall seen in a
+  // gap between parked cars: 2; a car seen whole: 0). NaN without a range profile.
+  double hidden_ends = std::numeric_limits<double>::quiet_NaN();
 };
 
 // The ring of a 3-D scan's highest beam: the largest mean elevation over a sample of its returns
@@ -56,12 +62,19 @@ int TopRing(const LadarScan& scan);
 
 // The returns idx of pts (non-empty), with segment_of[i] the segment index of return i (-1 for
 // none) and segment_extent[s] each segment's bounding-box diagonal; top_ring: TopRing of the
-// scan. scratch: reused buffer.
+// scan; profile: the scan's range profile (null or empty: hidden_ends stays NaN). scratch:
+// reused buffer.
 ReturnEvidence MeasureReturns(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
                               const std::vector<std::int32_t>& segment_of,
                               const std::vector<float>& segment_extent,
                               const Eigen::Vector2d& sensor_xy, bool three_d, int top_ring,
-                              std::vector<float>* scratch);
+                              const RangeProfile* profile, std::vector<float>* scratch);
+
+// Of the returns idx (centroid: their mean), the ends (extreme bearings from sensor_xy) that
+// are not free in profile (RangeProfile::FreeBeyond): 0, 1 or 2; 2 if they span no bearing.
+int HiddenEnds(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
+               const Eigen::Vector2d& centroid, const Eigen::Vector2d& sensor_xy,
+               const RangeProfile& profile);
 
 // The full feature vector: the returns' features and the track's state after its update
 // (speed [m/s]: of the reported hypothesis' centre).

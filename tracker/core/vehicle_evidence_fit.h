@@ -38,24 +38,26 @@ inline const std::vector<EvidenceTerm> kTerms3D = {
     {EvidenceFeature::kTopBeam, 1, 0.731577435, 1.34667217, -2.3022277},
     {EvidenceFeature::kTopBeam, 2, 0.731577435, 1.34667217, 0.478033899},
 };
-inline constexpr double kBias2D = 0.34763638;
+inline constexpr double kBias2D = 0.958693975;
 inline const std::vector<EvidenceTerm> kTerms2D = {
-    {EvidenceFeature::kLogPoints, 1, 2.5694787, 0.978242697, -0.150368337},
-    {EvidenceFeature::kLogPoints, 2, 2.5694787, 0.978242697, -0.196457754},
-    {EvidenceFeature::kLogRange, 1, 2.76913162, 0.663740291, -0.52158155},
-    {EvidenceFeature::kLogRange, 2, 2.76913162, 0.663740291, -0.0245073262},
-    {EvidenceFeature::kLength, 1, 3.94969848, 4.01434431, -2.19061713},
-    {EvidenceFeature::kLength, 2, 3.94969848, 4.01434431, -0.351242406},
-    {EvidenceFeature::kWidth, 1, 1.81406227, 1.84540539, 2.24019332},
-    {EvidenceFeature::kWidth, 2, 1.81406227, 1.84540539, -10.8072821},
-    {EvidenceFeature::kSegmentExtent, 1, 3.53704722, 4.33820808, 1.30797374},
-    {EvidenceFeature::kSegmentExtent, 2, 3.53704722, 4.33820808, -0.593060568},
-    {EvidenceFeature::kSpeed, 1, 1.24138911, 2.50048857, -2.6234529},
-    {EvidenceFeature::kSpeed, 2, 1.24138911, 2.50048857, 0.262948654},
-    {EvidenceFeature::kMover, 1, 0.0589177242, 0.235470648, 1.69416063},
-    {EvidenceFeature::kSmall, 1, 0.215380105, 0.411085776, -0.420987512},
-    {EvidenceFeature::kLengthUnseen, 1, 0.22606303, 0.418280452, -0.438578365},
-    {EvidenceFeature::kWidthUnseen, 1, 0.256157154, 0.436509641, -1.48366872},
+    {EvidenceFeature::kLogPoints, 1, 2.5694787, 0.978242697, -0.458482527},
+    {EvidenceFeature::kLogPoints, 2, 2.5694787, 0.978242697, -0.238565194},
+    {EvidenceFeature::kLogRange, 1, 2.76913162, 0.663740291, -0.575511005},
+    {EvidenceFeature::kLogRange, 2, 2.76913162, 0.663740291, 0.0401490089},
+    {EvidenceFeature::kLength, 1, 3.94969848, 4.01434431, -1.77824332},
+    {EvidenceFeature::kLength, 2, 3.94969848, 4.01434431, -0.499064674},
+    {EvidenceFeature::kWidth, 1, 1.81406227, 1.84540539, 2.50127109},
+    {EvidenceFeature::kWidth, 2, 1.81406227, 1.84540539, -10.3749319},
+    {EvidenceFeature::kSegmentExtent, 1, 3.53704722, 4.33820808, 1.5663652},
+    {EvidenceFeature::kSegmentExtent, 2, 3.53704722, 4.33820808, -0.723767073},
+    {EvidenceFeature::kHiddenEnds, 1, 0.887795453, 0.743692767, -0.501942884},
+    {EvidenceFeature::kHiddenEnds, 2, 0.887795453, 0.743692767, -0.494745298},
+    {EvidenceFeature::kSpeed, 1, 1.24138911, 2.50048857, -2.33491799},
+    {EvidenceFeature::kSpeed, 2, 1.24138911, 2.50048857, 0.233068997},
+    {EvidenceFeature::kMover, 1, 0.0589177242, 0.235470648, 1.50645999},
+    {EvidenceFeature::kSmall, 1, 0.215380105, 0.411085776, -0.239189434},
+    {EvidenceFeature::kLengthUnseen, 1, 0.22606303, 0.418280452, -0.392833593},
+    {EvidenceFeature::kWidthUnseen, 1, 0.256157154, 0.436509641, -1.45213115},
 };
 
 }  // namespace vtrack::evidence_fit

@@ -9,7 +9,9 @@
 #include <random>
 #include <vector>
 
+#include "base/angle.h"
 #include "tracker/core/preprocess.h"
+#include "tracker/core/range_profile.h"
 #include "tracker/core/scan.h"
 #include "tracker/core/ekf.h"
 #include "tracker/core/track.h"
@@ -108,7 +110,7 @@ TEST(VehicleEvidence, ReturnsGiveTheirHeightProfileColumnTopRangeAndSegmentExten
   const std::vector<float> extent = {3.0f, 7.5f};
   std::vector<float> scratch;
   const ReturnEvidence r =
-      MeasureReturns(pts, idx, segment_of, extent, Eigen::Vector2d(2.0, 5.0), true, 3, &scratch);
+      MeasureReturns(pts, idx, segment_of, extent, Eigen::Vector2d(2.0, 5.0), true, 3, nullptr, &scratch);
 
   std::vector<float> sorted = pts.height;
   std::sort(sorted.begin(), sorted.end());
@@ -124,7 +126,7 @@ TEST(VehicleEvidence, ReturnsGiveTheirHeightProfileColumnTopRangeAndSegmentExten
   EXPECT_FLOAT_EQ(r.column_top, 1.7f);  // the median: 75 of 101 at 1.7 m
   for (int i = 0; i < 60; ++i) pts.column_top[static_cast<std::size_t>(i)] = 14.0f;
   const ReturnEvidence under =
-      MeasureReturns(pts, idx, segment_of, extent, Eigen::Vector2d(2.0, 5.0), true, 3, &scratch);
+      MeasureReturns(pts, idx, segment_of, extent, Eigen::Vector2d(2.0, 5.0), true, 3, nullptr, &scratch);
   EXPECT_FLOAT_EQ(under.column_top, 10.0f);  // 60 of 101 at 14 m: the median, clipped
   EXPECT_NEAR(r.range, std::hypot(cx - 2.0, cy - 5.0), 1e-9);
   EXPECT_FLOAT_EQ(r.segment_extent, 7.5f);
@@ -132,9 +134,59 @@ TEST(VehicleEvidence, ReturnsGiveTheirHeightProfileColumnTopRangeAndSegmentExten
 
   // Single-plane: no heights.
   const ReturnEvidence flat =
-      MeasureReturns(pts, idx, segment_of, extent, Eigen::Vector2d(2.0, 5.0), false, 3, &scratch);
+      MeasureReturns(pts, idx, segment_of, extent, Eigen::Vector2d(2.0, 5.0), false, 3, nullptr, &scratch);
   EXPECT_EQ(flat.height_max, 0.0);
   EXPECT_EQ(flat.height_median, 0.0);
+}
+
+// The ends of a track's returns, against a single-plane profile built here: a face 20 m ahead
+// seen alone has both ends free; a nearer return just beyond one end hides that end; the same
+// face inside a longer one at the same range (a wall seen in part) has neither end free.
+TEST(VehicleEvidence, HiddenEndsCountsTheEndsThatAreNotFree) {
+  const Eigen::Vector2d sensor(0.0, 0.0);
+  const double step_deg = 0.5;  // the bearing step of the returns
+  // Returns at 20 m, bearings k * step for k in [k0, k1]; the track holds those of [-4, 4].
+  auto face = [&](int k0, int k1, double range, WorldPoints* pts) {
+    for (int k = k0; k <= k1; ++k) {
+      const double a = DegToRad(k * step_deg);
+      pts->push_back(range * std::cos(a), range * std::sin(a), 1.0f, static_cast<std::int32_t>(pts->size()), 0);
+    }
+  };
+  auto hidden = [&](const WorldPoints& pts) {
+    std::vector<std::int32_t> idx;
+    Eigen::Vector2d c = Eigen::Vector2d::Zero();
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      if (std::abs(std::hypot(pts.x[i], pts.y[i]) - 20.0) < 1e-6 &&
+          std::abs(std::atan2(pts.y[i], pts.x[i])) <= DegToRad(4.01 * step_deg)) {
+        idx.push_back(static_cast<std::int32_t>(i));
+        c += Eigen::Vector2d(pts.x[i], pts.y[i]);
+      }
+    }
+    EXPECT_EQ(idx.size(), 9u);
+    RangeProfile profile;
+    profile.Build(sensor, pts.x, pts.y, 1.5 * step_deg);
+    return HiddenEnds(pts, idx, c / static_cast<double>(idx.size()), sensor, profile);
+  };
+  WorldPoints alone;
+  face(-4, 4, 20.0, &alone);
+  face(-60, -20, 45.0, &alone);  // background well beyond: farther, not hiding
+  face(20, 60, 45.0, &alone);
+  EXPECT_EQ(hidden(alone), 0);
+  WorldPoints occluded = alone;
+  face(5, 9, 12.0, &occluded);  // a nearer object just beyond the end at +4 steps
+  EXPECT_EQ(hidden(occluded), 1);
+  WorldPoints wall;
+  face(-4, 4, 20.0, &wall);
+  face(-12, -5, 20.0, &wall);  // the face goes on at the same range on both sides
+  face(5, 12, 20.0, &wall);
+  EXPECT_EQ(hidden(wall), 2);
+  // The bearing step of a scan, from its returns in order.
+  std::vector<float> x, y;
+  for (int k = -100; k <= 100; ++k) {
+    x.push_back(static_cast<float>(30.0 * std::cos(DegToRad(k * step_deg))));
+    y.push_back(static_cast<float>(30.0 * std::sin(DegToRad(k * step_deg))));
+  }
+  EXPECT_NEAR(MedianBearingStepDeg(x, y), step_deg, 1e-4);
 }
 
 TEST(VehicleEvidence, TopRingIsTheHighestBeamWhicheverWayRingsAreNumbered) {

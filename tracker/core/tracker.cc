@@ -314,7 +314,10 @@ bool Tracker::ObserveEvidence(std::size_t index, const std::vector<std::int32_t>
                               ScanOutput::EvidenceRow* row) {
   const ReturnEvidence r =
       MeasureReturns(points_, idx, segment_of_, segment_extent_, sensor_xy, three_d, top_ring_,
-                     &profile_, &w->evidence_scratch);
+                     record_evidence_ || UsesFeature(params_.evidence, three_d, EvidenceFeature::kHiddenEnds)
+                         ? &profile_
+                         : nullptr,
+                     &w->evidence_scratch);
   row->logit = manager_->ObserveEvidence(index, r, record_evidence_ ? &row->features : nullptr);
   if (!record_evidence_) return false;
   const Track& t = manager_->tracks()[index];

@@ -147,6 +147,12 @@ EvidenceFeatures FeaturesOf(const ReturnEvidence& r, const Track& t, double spee
   return f;
 }
 
+bool UsesFeature(const EvidenceParams& p, bool three_d, EvidenceFeature k) {
+  const auto& terms = three_d ? p.terms_3d : p.terms_2d;
+  return std::any_of(terms.begin(), terms.end(),
+                     [k](const EvidenceTerm& term) { return term.feature == k && term.weight != 0.0; });
+}
+
 double ScanLogit(const EvidenceParams& p, bool three_d, const EvidenceFeatures& f) {
   double l = three_d ? p.bias_3d : p.bias_2d;
   for (const EvidenceTerm& term : three_d ? p.terms_3d : p.terms_2d) {

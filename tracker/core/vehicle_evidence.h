@@ -80,6 +80,9 @@ int HiddenEnds(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
 // (speed [m/s]: of the reported hypothesis' centre).
 EvidenceFeatures FeaturesOf(const ReturnEvidence& r, const Track& t, double speed);
 
+// True if the 3-D or the single-plane model has a term on feature k (else it need not be measured).
+bool UsesFeature(const EvidenceParams& p, bool three_d, EvidenceFeature k);
+
 // The scan's logit l(f) under the 3-D or the single-plane model.
 double ScanLogit(const EvidenceParams& p, bool three_d, const EvidenceFeatures& f);
 

@@ -65,6 +65,7 @@ TEST(VehicleEvidence, LogitIsTheSumOfItsTermsAndAccumulationIsDiscountedAndClamp
 // and its indicator is 1. A 0 in its place would read as a 0 m wide object.
 TEST(VehicleEvidence, AnUnestimatedDimensionIsMissingNotZero) {
   EvidenceParams p;
+  p.terms_3d.clear();
   p.bias_2d = -1.0;
   p.terms_2d = {{EvidenceFeature::kWidth, 1, 1.5, 0.5, 2.0},
                 {EvidenceFeature::kWidth, 2, 1.5, 0.5, -3.0},
@@ -84,6 +85,10 @@ TEST(VehicleEvidence, AnUnestimatedDimensionIsMissingNotZero) {
   EXPECT_EQ(f[static_cast<std::size_t>(EvidenceFeature::kLength)], 5.0);
   // bias + length z = 0.5 + indicator z = 1.5; both width terms absent.
   EXPECT_NEAR(ScanLogit(p, false, f), -1.0 + 0.5 - 0.75, 1e-12);
+
+  EXPECT_TRUE(UsesFeature(p, false, EvidenceFeature::kWidth));
+  EXPECT_FALSE(UsesFeature(p, false, EvidenceFeature::kHiddenEnds));
+  EXPECT_FALSE(UsesFeature(p, true, EvidenceFeature::kWidth));  // the 3-D model's own terms
 
   t.hyps[0].width_est = 2.0;  // the second face seen: z = 1, 2 * 1 - 3 * 1
   f = FeaturesOf(r, t, 0.0);

@@ -129,6 +129,10 @@ void Read(const YAML::Node& root, const std::string& origin, TrackerParams* p) {
   if (!p->Validate(&error)) throw std::runtime_error(origin + ": " + error);
 }
 
+// Lists of mappings longer than this are written one item per line (an ensemble's tree nodes),
+// shorter ones on the key's line.
+constexpr std::size_t kFlowListItems = 40;
+
 // A field's value as YAML writes it (lists of mappings in flow style).
 class ValueText {
  public:
@@ -144,16 +148,24 @@ class ValueText {
       return NameOf(*value);
     } else if constexpr (requires { value->front().Visit(std::declval<ValueText&>()); }) {
       std::string out = "[";
-      for (std::size_t i = 0; i < value->size(); ++i) {
-        ValueText item;
-        item.nested_ = true;
-        (*value)[i].Visit(item);
-        out += (i ? ", {" : "{") + item.text_ + "}";
-      }
+      const std::vector<std::string> items = Items(value);
+      for (std::size_t i = 0; i < items.size(); ++i) out += (i ? ", " : "") + items[i];
       return out + "]";
     } else {
       return param::Format(*value);
     }
+  }
+  // Each item of a list of mappings in flow style, "{key: value, ...}".
+  template <class T>
+  static std::vector<std::string> Items(std::vector<T>* value) {
+    std::vector<std::string> out;
+    for (T& v : *value) {
+      ValueText item;
+      item.nested_ = true;
+      v.Visit(item);
+      out.push_back("{" + item.text_ + "}");
+    }
+    return out;
   }
 
  private:
@@ -226,6 +238,13 @@ void WriteConfigYaml(const TrackerParams& params, std::ostream& out) {
     using Section = std::remove_pointer_t<decltype(section)>;
     out << "\n" << Section::kSection << ":  # " << Section::kAbout << "\n";
     auto line = [&](const char* key, auto* value, const param::Info& info) {
+      if constexpr (requires { ValueText::Items(value); }) {
+        if (value->size() > kFlowListItems) {  // a long list: one item per line
+          out << "  " << key << ":  # [" << info.unit << "] " << info.reason << "\n";
+          for (const std::string& item : ValueText::Items(value)) out << "    - " << item << "\n";
+          return;
+        }
+      }
       std::string entry = std::string("  ") + key + ": " + ValueText::Of(value);
       if (entry.size() < 34) entry.resize(34, ' ');
       out << entry << "  # [" << info.unit << "] " << info.reason << "\n";
@@ -248,7 +267,13 @@ void WriteParameterReference(std::ostream& out) {
     out << "\n## `" << Section::kSection << "`\n\n" << Section::kAbout << ".\n\n"
         << "| key | default | unit | valid | reason |\n| --- | --- | --- | --- | --- |\n";
     auto row = [&](const char* key, auto* value, const param::Info& info) {
-      out << "| `" << key << "` | " << Cell(ValueText::Of(value)) << " | " << info.unit << " | "
+      std::string shown = ValueText::Of(value);
+      if constexpr (requires { ValueText::Items(value); }) {
+        if (value->size() > kFlowListItems) {
+          shown = std::to_string(value->size()) + " items (listed in `config/tracker.yaml`)";
+        }
+      }
+      out << "| `" << key << "` | " << Cell(shown) << " | " << info.unit << " | "
           << Cell(ValidText(value, info)) << " | " << Cell(info.reason) << " |\n";
     };
     section->Visit(row);

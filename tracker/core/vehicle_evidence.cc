@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "tracker/core/preprocess.h"
 #include "tracker/core/range_profile.h"
@@ -148,13 +149,72 @@ EvidenceFeatures FeaturesOf(const ReturnEvidence& r, const Track& t, double spee
 }
 
 bool UsesFeature(const EvidenceParams& p, bool three_d, EvidenceFeature k) {
+  if ((three_d ? p.model_3d : p.model_2d) == EvidenceModel::kTrees) {
+    const auto& nodes = three_d ? p.trees_3d : p.trees_2d;
+    return std::any_of(nodes.begin(), nodes.end(),
+                       [k](const EvidenceNode& n) { return n.left >= 0 && n.feature == k; });
+  }
   const auto& terms = three_d ? p.terms_3d : p.terms_2d;
   return std::any_of(terms.begin(), terms.end(),
                      [k](const EvidenceTerm& term) { return term.feature == k && term.weight != 0.0; });
 }
 
+namespace {
+
+// The sum of the leaves the scan reaches, one per tree (EvidenceNode).
+double TreesLogit(const std::vector<EvidenceNode>& nodes, const EvidenceFeatures& f) {
+  double l = 0.0;
+  const std::size_t n = nodes.size();
+  for (std::size_t root = 0; root < n; ++root) {
+    if (root > 0 && nodes[root].tree == nodes[root - 1].tree) continue;  // not a tree's first node
+    std::size_t i = root;
+    while (nodes[i].left >= 0) {
+      const EvidenceNode& node = nodes[i];
+      const double v = f[static_cast<std::size_t>(node.feature)];
+      i = static_cast<std::size_t>(v > node.threshold ? node.right : node.left);  // NaN: left
+    }
+    l += nodes[i].value;
+  }
+  return l;
+}
+
+// The first node of list whose children are not later nodes of its own tree, or whose tree
+// number goes down; "" if none.
+std::string TreeProblem(const char* key, const std::vector<EvidenceNode>& list) {
+  const int n = static_cast<int>(list.size());
+  for (int i = 0; i < n; ++i) {
+    const EvidenceNode& node = list[static_cast<std::size_t>(i)];
+    const std::string where = std::string(key) + "[" + std::to_string(i) + "]";
+    if (i > 0 && node.tree < list[static_cast<std::size_t>(i - 1)].tree) {
+      return param::Problem((where + ".tree").c_str(), node.tree, "-",
+                            "at least the previous node's (a tree's nodes are contiguous)");
+    }
+    if ((node.left < 0) != (node.right < 0)) {
+      return where + ": left and right must both be -1 (a leaf) or both name children";
+    }
+    for (const int c : {node.left, node.right}) {
+      if (c >= 0 && (c <= i || c >= n || list[static_cast<std::size_t>(c)].tree != node.tree)) {
+        return param::Problem((where + ".left/right").c_str(), c, "-",
+                              "a later node of the same tree (the list has " + std::to_string(n) + ")");
+      }
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+std::string EvidenceParams::CrossProblem() const {
+  std::string problem = TreeProblem("trees_3d", trees_3d);
+  return problem.empty() ? TreeProblem("trees_2d", trees_2d) : problem;
+}
+
 double ScanLogit(const EvidenceParams& p, bool three_d, const EvidenceFeatures& f) {
-  double l = three_d ? p.bias_3d : p.bias_2d;
+  const double bias = three_d ? p.bias_3d : p.bias_2d;
+  if ((three_d ? p.model_3d : p.model_2d) == EvidenceModel::kTrees) {
+    return bias + TreesLogit(three_d ? p.trees_3d : p.trees_2d, f);
+  }
+  double l = bias;
   for (const EvidenceTerm& term : three_d ? p.terms_3d : p.terms_2d) {
     const double v = f[static_cast<std::size_t>(term.feature)];
     if (!std::isfinite(v)) continue;  // missing: at the training mean, z = 0

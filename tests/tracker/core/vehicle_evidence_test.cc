@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "base/angle.h"
@@ -23,6 +25,7 @@ namespace {
 
 TEST(VehicleEvidence, LogitIsTheSumOfItsTermsAndAccumulationIsDiscountedAndClamped) {
   EvidenceParams p;
+  p.model_3d = p.model_2d = EvidenceModel::kLogistic;
   p.prior = 0.2;
   p.scan_weight = 0.25;
   p.accumulation = EvidenceAccumulation::kSum;
@@ -65,6 +68,7 @@ TEST(VehicleEvidence, LogitIsTheSumOfItsTermsAndAccumulationIsDiscountedAndClamp
 // and its indicator is 1. A 0 in its place would read as a 0 m wide object.
 TEST(VehicleEvidence, AnUnestimatedDimensionIsMissingNotZero) {
   EvidenceParams p;
+  p.model_3d = p.model_2d = EvidenceModel::kLogistic;
   p.terms_3d.clear();
   p.bias_2d = -1.0;
   p.terms_2d = {{EvidenceFeature::kWidth, 1, 1.5, 0.5, 2.0},
@@ -94,6 +98,52 @@ TEST(VehicleEvidence, AnUnestimatedDimensionIsMissingNotZero) {
   f = FeaturesOf(r, t, 0.0);
   EXPECT_EQ(f[static_cast<std::size_t>(EvidenceFeature::kWidthUnseen)], 0.0);
   EXPECT_NEAR(ScanLogit(p, false, f), -1.0 + 2.0 - 3.0 + 0.5 + (-0.5) * (-0.5), 1e-12);
+}
+
+// A boosted ensemble: the logit is the bias plus the leaf each tree sends the scan to, a missing
+// feature going left; a list whose children do not follow their parent in the same tree is refused.
+TEST(VehicleEvidence, TreesSumTheLeavesTheScanReachesAndSendMissingFeaturesLeft) {
+  EvidenceParams p;
+  p.model_2d = EvidenceModel::kTrees;
+  p.bias_2d = 0.5;
+  using F = EvidenceFeature;
+  p.trees_2d = {
+      {0, F::kWidth, 1.0, 1, 2, 0.0},    // 0: width <= 1 m?
+      {0, F::kLogPoints, 0.0, -1, -1, 0.3},
+      {0, F::kLength, 3.0, 3, 4, 0.0},   // 2: length <= 3 m?
+      {0, F::kLogPoints, 0.0, -1, -1, -0.2},
+      {0, F::kLogPoints, 0.0, -1, -1, 1.1},
+      {1, F::kLogPoints, 0.0, -1, -1, 0.05},  // a tree that is one leaf
+  };
+  std::string error;
+  ASSERT_TRUE(p.Validate(&error)) << error;
+  EvidenceFeatures f{};
+  auto set = [&f](F k, double v) { f[static_cast<std::size_t>(k)] = v; };
+  set(F::kWidth, 2.0);
+  set(F::kLength, 4.0);
+  EXPECT_NEAR(ScanLogit(p, false, f), 0.5 + 1.1 + 0.05, 1e-12);
+  set(F::kLength, 3.0);  // at the threshold: left
+  EXPECT_NEAR(ScanLogit(p, false, f), 0.5 - 0.2 + 0.05, 1e-12);
+  set(F::kWidth, std::numeric_limits<double>::quiet_NaN());  // missing: left
+  EXPECT_NEAR(ScanLogit(p, false, f), 0.5 + 0.3 + 0.05, 1e-12);
+  EXPECT_TRUE(UsesFeature(p, false, F::kLength));
+  EXPECT_FALSE(UsesFeature(p, false, F::kSpeed));
+  EXPECT_FALSE(UsesFeature(p, false, F::kLogPoints)) << "leaves compare nothing";
+
+  EvidenceParams bad = p;
+  bad.trees_2d[2].left = 1;  // before its parent
+  EXPECT_FALSE(bad.Validate(&error));
+  EXPECT_NE(error.find("trees_2d[2]"), std::string::npos) << error;
+  bad = p;
+  bad.trees_2d[2].right = 5;  // a node of the next tree
+  EXPECT_FALSE(bad.Validate(&error));
+  bad = p;
+  bad.trees_2d[0].right = -1;  // half a split
+  EXPECT_FALSE(bad.Validate(&error));
+  bad = p;
+  bad.trees_2d[5].tree = 0;  // tree numbers must not go down ...
+  bad.trees_2d[4].tree = 1;
+  EXPECT_FALSE(bad.Validate(&error));
 }
 
 TEST(VehicleEvidence, ReturnsGiveTheirHeightProfileColumnTopRangeAndSegmentExtent) {
@@ -232,6 +282,7 @@ TEST(VehicleEvidence, ASmallObjectClassedVehicleIsReportedAtAVehiclesSize) {
   TrackerParams p;
   p.evidence.classifier_3d = VehicleClassifier::kEvidence;
   p.evidence.bias_3d = 8.0;  // every scan says "vehicle"
+  p.evidence.model_3d = EvidenceModel::kLogistic;
   p.evidence.terms_3d.clear();
   const Ekf ekf(p.ism, p.vasm, p.ekf, p.cv);
   TrackManager manager(p.manager, ekf, p.fit, p.shape);

@@ -555,10 +555,11 @@ struct DetectionParams {
   bool Validate(std::string* error) const { return param::Validate(*this, error); }
 };
 
-// The vehicle evidence of a track (vehicle_evidence.h): per scan a logistic model of what the
-// scan measured of the track, accumulated over its life as log-odds. The terms and biases are
-// fitted by scripts/fit-vehicle-evidence from tracks labelled against ground truth; they are
-// written into config/tracker.yaml by that script, and the defaults here are its output.
+// The vehicle evidence of a track (vehicle_evidence.h): per scan a model of what the scan
+// measured of the track (boosted trees or a logistic model), accumulated over its life as
+// log-odds. The trees, terms and biases are fitted by scripts/fit-vehicle-evidence from tracks
+// labelled against ground truth; the defaults here are its output, which
+// scripts/check-parameters carries into config/tracker.yaml.
 enum class EvidenceFeature : std::int8_t {
   kLogPoints,      // [-] ln(returns of the track on the scan)
   kLogRange,       // [-] ln(range of their centroid from the sensor / 1 m)
@@ -674,7 +675,7 @@ namespace vtrack {
 struct EvidenceParams {
   static constexpr const char* kSection = "evidence";
   static constexpr const char* kAbout =
-      "Vehicle evidence of each track: a fitted per-scan logistic model accumulated as log-odds";
+      "Vehicle evidence of each track: a fitted per-scan model (boosted trees or logistic) accumulated as log-odds";
   VehicleClassifier classifier_3d = VehicleClassifier::kEvidence;
   VehicleClassifier classifier_2d = VehicleClassifier::kEvidence;
   double prior = evidence_fit::kPrior;

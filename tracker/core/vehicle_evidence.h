@@ -4,7 +4,10 @@
 // Per scan that gives the track returns, a feature vector f (EvidenceFeature, parameters.h):
 // the returns' height profile above the local ground (3-D clouds), their number and range, how
 // high their columns reach (crowns and building fronts above max_height), the extent of the
-// segment they belong to, and the track's own footprint and motion. A logistic model gives the scan's log posterior odds at the fitting set's prior pi,
+// segment they belong to, how many of their ends are hidden, and the track's own footprint and
+// motion. A per-scan model gives the scan's log posterior odds at the fitting set's prior pi:
+// boosted trees, l(f) = bias + the sum over the trees of the leaf f reaches (a missing feature
+// goes left at every split), or a logistic model,
 //   l(f) = bias + sum_k w_k ((f_k - c_k) / s_k)^p_k,
 // where a missing feature (a length or width not estimated yet: NaN) adds nothing, i.e. sits at
 // its training mean c_k, and an indicator feature says that it is missing;

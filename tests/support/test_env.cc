@@ -2,14 +2,57 @@
 
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <mutex>
+#include <string>
+#include <system_error>
+#include <vector>
 
 namespace vtrack::testing {
 namespace {
 std::string Env(const char* name, const std::string& fallback) {
   const char* v = std::getenv(name);
   return (v && *v) ? std::string(v) : fallback;
+}
+
+// The scratch directories of this test process, removed when it exits if every test passed
+// (some hold logs of hundreds of MB; left behind, repeated runs fill the disk), kept and named
+// when one failed. Only the process that made them removes them: a forked child that exits
+// normally runs this destructor too.
+class ScratchRegistry {
+ public:
+  ~ScratchRegistry() {
+    if (::getpid() != owner_) return;
+    const bool passed = ::testing::UnitTest::GetInstance()->Passed();
+    for (const std::string& d : dirs_) {
+      if (passed) {
+        std::error_code ec;
+        std::filesystem::remove_all(d, ec);
+      } else {
+        std::fprintf(stderr, "scratch directory kept for inspection: %s\n", d.c_str());
+      }
+    }
+  }
+  void Add(const std::string& dir) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    for (const std::string& d : dirs_) {
+      if (d == dir) return;
+    }
+    dirs_.push_back(dir);
+  }
+
+ private:
+  const pid_t owner_ = ::getpid();
+  std::mutex mutex_;
+  std::vector<std::string> dirs_;
+};
+
+ScratchRegistry& Scratch() {
+  // Made after gtest's UnitTest (ScratchDir runs inside tests), so destroyed before it.
+  static ScratchRegistry registry;
+  return registry;
 }
 }  // namespace
 
@@ -24,6 +67,7 @@ std::string ScratchDir(const std::string& name) {
                        ("vtrack-test-" + name + "-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
+  Scratch().Add(dir.string());
   return dir.string();
 }
 

@@ -13,7 +13,8 @@ std::string SourceDir();   // repository root
 std::string BinDir();      // built executables
 std::string DataDir();     // ../shared/data (may not exist)
 std::string JarPath();     // the message types' jar, "" if not built
-// A fresh empty directory under the system temp dir, removed by nothing (inspect after failure).
+// A fresh empty directory under the system temp dir (named after name and the process), removed
+// when the test process exits if every test passed, kept for inspection if one failed.
 std::string ScratchDir(const std::string& name);
 // The KITTI tracking sequence 0000 directory if present, else "".
 std::string KittiDir();

@@ -93,6 +93,39 @@ TEST(TrackerConfigTest, DeclaredRangesAreEnforced) {
             std::string::npos);
 }
 
+// The evidence's tree lists: a node whose child lies before it or in another tree, a leaf with
+// one child, a feature that does not exist, and a model whose list is empty are refused by name.
+TEST(TrackerConfigTest, MalformedEvidenceTreesAreRefused) {
+  const std::string two_trees =
+      "evidence:\n  model_2d: trees\n  trees_2d:\n"
+      "    - {tree: 0, feature: width, threshold: 1.0, left: 1, right: 2, value: 0}\n"
+      "    - {tree: 0, feature: width, threshold: 0, left: -1, right: -1, value: 0.5}\n"
+      "    - {tree: 0, feature: width, threshold: 0, left: -1, right: -1, value: -0.5}\n"
+      "    - {tree: 1, feature: width, threshold: 0, left: -1, right: -1, value: 0.1}\n";
+  const TrackerParams p = ParseTrackerParams(two_trees, "inline");
+  ASSERT_EQ(p.evidence.trees_2d.size(), 4u);
+  EXPECT_EQ(p.evidence.trees_2d[0].feature, EvidenceFeature::kWidth);
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string y = two_trees;
+    y.replace(y.find(from), from.size(), to);
+    return ErrorOf(y);
+  };
+  EXPECT_NE(with("left: 1, right: 2", "left: 1, right: 0").find("evidence.trees_2d[0].left/right = 0"),
+            std::string::npos) << with("left: 1, right: 2", "left: 1, right: 0");
+  EXPECT_NE(with("left: 1, right: 2", "left: 1, right: 3").find("trees_2d[0].left/right = 3"),
+            std::string::npos);  // a node of tree 1
+  EXPECT_NE(with("left: 1, right: 2", "left: 1, right: -1").find("trees_2d[0]: left and right"),
+            std::string::npos);
+  EXPECT_NE(with("feature: width, threshold: 1.0", "feature: colour, threshold: 1.0")
+                .find("trees_2d[0].feature = 'colour'"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("evidence:\n  model_2d: trees\n  trees_2d: []\n").find("model_2d = trees: trees_2d is empty"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("evidence:\n  model_3d: logistic\n  terms_3d: []\n")
+                .find("model_3d = logistic: terms_3d is empty"),
+            std::string::npos);
+}
+
 TEST(TrackerConfigTest, OverridesAndPartialFiles) {
   const TrackerParams p = ParseTrackerParams(
       "manager:\n  mode: vasm\n  vasm_variants:\n    - {inside_fraction: 0.6, noise_scale: 2}\n"

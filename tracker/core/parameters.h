@@ -711,7 +711,8 @@ struct EvidenceParams {
     v("terms_2d", &terms_2d, {"-", {}, "single-plane scans: the logistic model's terms (fitted)"});
     v("trees_2d", &trees_2d, {"-", {}, "single-plane scans: the boosted trees' nodes (fitted)"});
   }
-  // Each tree's children lie after their parent, in the list and in the same tree.
+  // The chosen family's list is not empty; each tree's children lie after their parent, in the
+  // list and in the same tree.
   std::string CrossProblem() const;
   bool Validate(std::string* error) const { return param::Validate(*this, error); }
 };

@@ -52,6 +52,10 @@ Tracker::Tracker(const TrackerParams& params, bool debug)
   ekf_ = std::make_unique<Ekf>(params_.ism, params_.vasm, params_.ekf, params_.cv);
   manager_ = std::make_unique<TrackManager>(params_.manager, *ekf_, params_.fit, params_.shape);
   manager_->SetEvidence(params_.evidence);
+  for (const bool three_d : {false, true}) {
+    hidden_ends_used_[three_d ? 1 : 0] =
+        UsesFeature(params_.evidence, three_d, EvidenceFeature::kHiddenEnds);
+  }
   for (int k = 0; k < params_.compute.threads; ++k) {
     workers_.emplace_back(params_.outline, manager_->NewMeasurer());
   }
@@ -314,9 +318,7 @@ bool Tracker::ObserveEvidence(std::size_t index, const std::vector<std::int32_t>
                               ScanOutput::EvidenceRow* row) {
   const ReturnEvidence r =
       MeasureReturns(points_, idx, segment_of_, segment_extent_, sensor_xy, three_d, top_ring_,
-                     record_evidence_ || UsesFeature(params_.evidence, three_d, EvidenceFeature::kHiddenEnds)
-                         ? &profile_
-                         : nullptr,
+                     record_evidence_ || hidden_ends_used_[three_d ? 1 : 0] ? &profile_ : nullptr,
                      &w->evidence_scratch);
   row->logit = manager_->ObserveEvidence(index, r, record_evidence_ ? &row->features : nullptr);
   if (!record_evidence_) return false;

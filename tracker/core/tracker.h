@@ -168,6 +168,9 @@ class Tracker {
   std::vector<float> segment_extent_;     // [m] per segment: bounding-box diagonal
   int top_ring_ = -1;                     // TopRing of the scan being processed
   bool record_evidence_ = false;
+  // Whether the single-plane (0) and 3-D (1) evidence models use hidden_ends: only then (or when
+  // recording) are a track's ends looked up in the profile. Set once from the parameters.
+  bool hidden_ends_used_[2] = {false, false};
   std::int64_t returns_processed_ = 0;
 };
 

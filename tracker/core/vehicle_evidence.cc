@@ -205,6 +205,21 @@ std::string TreeProblem(const char* key, const std::vector<EvidenceNode>& list) 
 }  // namespace
 
 std::string EvidenceParams::CrossProblem() const {
+  // The fitted defaults hold the chosen family only: the other one's list is empty, and a model
+  // switched to it would be its bias alone, the same probability for every track.
+  for (const bool three_d : {true, false}) {
+    const EvidenceModel model = three_d ? model_3d : model_2d;
+    const bool empty = model == EvidenceModel::kTrees ? (three_d ? trees_3d : trees_2d).empty()
+                                                      : (three_d ? terms_3d : terms_2d).empty();
+    if (empty) {
+      const std::string d = three_d ? "3d" : "2d";
+      const bool trees = model == EvidenceModel::kTrees;
+      return "model_" + d + " = " + (trees ? "trees" : "logistic") + ": " +
+             (trees ? "trees_" : "terms_") + d + " is empty (fit that family: " +
+             "scripts/fit-vehicle-evidence --model-" + d + " " + (trees ? "trees" : "logistic") +
+             " --write, or give its list)";
+    }
+  }
   std::string problem = TreeProblem("trees_3d", trees_3d);
   return problem.empty() ? TreeProblem("trees_2d", trees_2d) : problem;
 }

@@ -115,8 +115,7 @@ std::string DefaultBinDir() {
 
 std::string FindKittiCalib(const CompareOptions& o, const CompareItem& item) {
   if (!o.kitti_calib.empty() && item.kind == CompareItem::Kind::kKitti) return o.kitti_calib;
-  const std::string seq = kitti::NormaliseSequence(
-      item.kind == CompareItem::Kind::kKittiBoxes ? item.sequence : o.kitti_sequence);
+  const std::string& seq = item.sequence;
   for (const fs::path& p : {fs::path(item.source) / "calib" / (seq + ".txt"),
                             fs::path(item.source) / "training" / "calib" / (seq + ".txt")}) {
     if (fs::is_regular_file(p)) return p.string();
@@ -126,9 +125,8 @@ std::string FindKittiCalib(const CompareOptions& o, const CompareItem& item) {
 }
 
 // The sequence's label file, for its DontCare regions ("" if there is none: then none apply).
-std::string FindKittiLabels(const CompareOptions& o, const CompareItem& item) {
-  const std::string seq = kitti::NormaliseSequence(
-      item.kind == CompareItem::Kind::kKittiBoxes ? item.sequence : o.kitti_sequence);
+std::string FindKittiLabels(const CompareItem& item) {
+  const std::string& seq = item.sequence;
   for (const fs::path& p : {fs::path(item.source) / "label_02" / (seq + ".txt"),
                             fs::path(item.source) / "training" / "label_02" / (seq + ".txt")}) {
     if (fs::is_regular_file(p)) return p.string();
@@ -330,7 +328,7 @@ int RunCompare(const CompareOptions& o) {
         argv = {tool("vtrack-sim-log"), "--scenario", item.source, "--out", run, "--seed",
                 std::to_string(o.seed)};
       } else if (item.kind == CompareItem::Kind::kKitti) {
-        argv = {tool("vtrack-kitti2lcm"), "--kitti", item.source, "--sequence", o.kitti_sequence,
+        argv = {tool("vtrack-kitti2lcm"), "--kitti", item.source, "--sequence", item.sequence,
                 "--out", run};
         if (!o.kitti_poses.empty()) argv.insert(argv.end(), {"--poses", o.kitti_poses});
         if (!o.kitti_oxts.empty()) argv.insert(argv.end(), {"--oxts", o.kitti_oxts});
@@ -340,7 +338,7 @@ int RunCompare(const CompareOptions& o) {
         kopt.kitti_calib = FindKittiCalib(o, item);
         kopt.region_camera = true;
         kopt.region_range_m = o.kitti_range_m;
-        if (o.kitti_dont_care) kopt.kitti_dont_care = FindKittiLabels(o, item);
+        if (o.kitti_dont_care) kopt.kitti_dont_care = FindKittiLabels(item);
         if (o.kitti_dont_care && kopt.kitti_dont_care.empty()) {
           say(item.name + ": no label_02 file: no DontCare regions");
         }
@@ -354,7 +352,7 @@ int RunCompare(const CompareOptions& o) {
         kopt.kitti_calib = FindKittiCalib(o, item);
         kopt.region_camera = true;
         kopt.region_range_m = o.kitti_range_m;
-        if (o.kitti_dont_care) kopt.kitti_dont_care = FindKittiLabels(o, item);
+        if (o.kitti_dont_care) kopt.kitti_dont_care = FindKittiLabels(item);
         if (o.kitti_dont_care && kopt.kitti_dont_care.empty()) {
           say(item.name + ": no label_02 file: no DontCare regions");
         }

@@ -28,7 +28,7 @@ struct CompareItem {
   Kind kind = Kind::kScenario;
   std::string name;      // [-] key in the table and the JSON: scenario name, or kitti_<sequence>
   std::string source;    // [-] scenario NAME or path; KITTI directory
-  std::string sequence;  // [-] kKittiBoxes: its sequence
+  std::string sequence;  // [-] kKitti, kKittiBoxes: its sequence (NNNN)
   std::string input_mode = "scans";  // [-] kKitti: vtrack-tracker --input-mode (scans | boxes | fused)
 };
 
@@ -44,7 +44,7 @@ struct CompareOptions {
   std::string tracker_config;         // [-] passed to vtrack-tracker --config
   std::string bin_dir;                // [-] where the vtrack executables are
   double timeout_s = 3600.0;          // [s] per child process; > 0
-  std::string kitti_sequence = "0000";
+  std::string kitti_sequence;  // [-] --kitti-sequence; "" = each folder's only point-cloud sequence
   std::string kitti_poses, kitti_oxts, kitti_calib;  // [-] "" = the converter's / DIR's default
   double kitti_range_m = 40.0;        // [m] KITTI scoring range; > 0
   bool kitti_dont_care = true;        // [-] KITTI: tracks in the labels' DontCare regions are not FP

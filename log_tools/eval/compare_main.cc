@@ -46,7 +46,8 @@ int main(int argc, char** argv) {
      "with --kitti: comma-separated vtrack-tracker input modes: scans, boxes (the sequence's\n"
      "detections/pointrcnn_Car alone) and/or fused (both); the boxes and fused items are named\n"
      "kitti_<sequence>_boxes and kitti_<sequence>_fused")
-    ("kitti-sequence", po::value(&o.kitti_sequence)->default_value(o.kitti_sequence), "KITTI sequence")
+    ("kitti-sequence", po::value(&o.kitti_sequence),
+     "KITTI sequence of every --kitti folder (default: each folder's only sequence with point clouds)")
     ("kitti-boxes", po::value(&kitti_boxes_dir),
      "KITTI folder of the boxes layout (label_02/, calib/, detections/pointrcnn_Car/,\n"
      "ego_pose_orbslam3/; no point clouds): every --sequences tracked from its detections\n"
@@ -90,13 +91,6 @@ int main(int argc, char** argv) {
     }
     if (o.reuse && o.work_dir.empty()) throw std::invalid_argument("--reuse needs --work-dir");
     for (const auto& s : SplitList(scenarios)) o.items.push_back(ScenarioItem(s));
-    if (!kitti_dirs.empty()) {
-      try {
-        o.kitti_sequence = vtrack::kitti::NormaliseSequence(o.kitti_sequence);
-      } catch (const std::exception& e) {
-        throw std::invalid_argument(std::string("--kitti-sequence: ") + e.what());
-      }
-    }
     const std::vector<std::string> input_modes = SplitList(kitti_input_modes);
     if (input_modes.empty()) throw std::invalid_argument("--kitti-input-modes is empty");
     for (const auto& m : input_modes) {
@@ -105,12 +99,20 @@ int main(int argc, char** argv) {
       }
     }
     for (const auto& d : kitti_dirs) {
+      std::string seq;
+      try {
+        seq = vtrack::kitti::ResolveSequence(d, o.kitti_sequence);
+      } catch (const std::exception& e) {
+        throw std::invalid_argument((o.kitti_sequence.empty() ? "--kitti " + d : std::string("--kitti-sequence")) +
+                                    ": " + e.what());
+      }
       for (const auto& m : input_modes) {
         CompareItem item;
         item.kind = CompareItem::Kind::kKitti;
         item.source = d;
+        item.sequence = seq;
         item.input_mode = m;
-        item.name = "kitti_" + o.kitti_sequence + (m == "scans" ? "" : "_" + m);
+        item.name = "kitti_" + seq + (m == "scans" ? "" : "_" + m);
         o.items.push_back(item);
       }
     }

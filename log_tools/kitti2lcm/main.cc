@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
 
   po::options_description desc(
       "vtrack-kitti2lcm: convert a KITTI tracking sequence to an LCM log\n\n"
-      "  vtrack-kitti2lcm --kitti DIR --sequence 0000 --out F.lcm [--poses F | --oxts F]\n\n"
+      "  vtrack-kitti2lcm --kitti DIR [--sequence NNNN] --out F.lcm [--poses F | --oxts F]\n\n"
       "DIR is the standard KITTI tracking layout (training/ or the folder holding it:\n"
       "velodyne/NNNN/*.bin, label_02/NNNN.txt, calib/NNNN.txt, oxts/NNNN.txt) or a folder\n"
       "with velodyne_NNNN.tar.zst instead of velodyne/ (unpacked once into --cache-dir).\n"
@@ -37,7 +37,8 @@ int main(int argc, char** argv) {
   desc.add_options()
       ("help,h", "print this help")
       ("kitti", po::value<std::string>(&seq_opt.dir)->required(), "KITTI directory")
-      ("sequence", po::value<std::string>(&seq_opt.sequence)->default_value("0000"), "sequence number")
+      ("sequence", po::value<std::string>(&seq_opt.sequence),
+       "sequence number (default: the folder's only sequence with point clouds)")
       ("out,o", po::value<std::string>(&conv.out)->required(), "output LCM log file")
       ("poses", po::value<std::string>(&seq_opt.poses_file),
        "ego poses, KITTI odometry layout (3x4 per line, Velodyne frame i -> frame 0)")

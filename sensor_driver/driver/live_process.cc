@@ -18,7 +18,8 @@ void AddLiveSourceOptions(po::options_description* desc,
   add_model_options(desc);
   desc->add_options()
       ("kitti", po::value<std::string>(), kitti_help)
-      ("sequence", po::value<std::string>()->default_value("0000"), "KITTI sequence number")
+      ("sequence", po::value<std::string>()->default_value(""),
+       "KITTI sequence number (default: the folder's only sequence with point clouds)")
       ("poses", po::value<std::string>(), "KITTI: odometry poses file (velo i -> velo 0)")
       ("oxts", po::value<std::string>(), "KITTI: OXTS file instead of poses")
       ("cache-dir", po::value<std::string>(), "KITTI: where packed point clouds are unpacked")

@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstdlib>
@@ -126,6 +127,13 @@ bool Exists(const fs::path& p) {
   return fs::exists(p, ec);
 }
 
+// A sequence's name as the layouts spell it: four decimal digits.
+bool IsSequenceName(const std::string& s) {
+  return s.size() == 4 && std::all_of(s.begin(), s.end(), [](char c) {
+           return std::isdigit(static_cast<unsigned char>(c)) != 0;
+         });
+}
+
 }  // namespace
 
 std::string NormaliseSequence(const std::string& sequence) {
@@ -138,6 +146,61 @@ std::string NormaliseSequence(const std::string& sequence) {
     }
   }
   return std::string(4 - sequence.size(), '0') + sequence;
+}
+
+std::vector<std::string> PointCloudSequences(const std::string& dir) {
+  std::vector<std::string> out;
+  for (const fs::path& root : {fs::path(dir), fs::path(dir) / "training"}) {
+    std::error_code ec;
+    if (!fs::is_directory(root, ec)) continue;
+    for (const auto& e : fs::directory_iterator(root, ec)) {
+      const std::string name = e.path().filename().string();
+      const std::string prefix = "velodyne_", suffix = ".tar.zst";
+      if (name.size() == prefix.size() + 4 + suffix.size() && name.rfind(prefix, 0) == 0 &&
+          name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+        const std::string seq = name.substr(prefix.size(), 4);
+        if (IsSequenceName(seq)) out.push_back(seq);
+      }
+    }
+    if (fs::is_directory(root / "velodyne", ec)) {
+      for (const auto& e : fs::directory_iterator(root / "velodyne", ec)) {
+        const std::string seq = e.path().filename().string();
+        if (IsSequenceName(seq) && e.is_directory(ec)) out.push_back(seq);
+      }
+    }
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+std::string ResolveSequence(const std::string& dir, const std::string& requested) {
+  if (!requested.empty()) return NormaliseSequence(requested);
+  if (dir.empty()) throw KittiError("no KITTI directory given");
+  if (!fs::is_directory(dir)) throw KittiError("KITTI directory " + dir + " does not exist");
+  std::vector<std::string> seqs = PointCloudSequences(dir);
+  if (seqs.empty()) {
+    // No point clouds (the boxes layout): the sequences with a calibration file.
+    for (const fs::path& calib : {fs::path(dir) / "calib", fs::path(dir) / "training" / "calib"}) {
+      std::error_code ec;
+      if (!fs::is_directory(calib, ec)) continue;
+      for (const auto& e : fs::directory_iterator(calib, ec)) {
+        const std::string seq = e.path().stem().string();
+        if (e.path().extension() == ".txt" && IsSequenceName(seq)) seqs.push_back(seq);
+      }
+    }
+    std::sort(seqs.begin(), seqs.end());
+    seqs.erase(std::unique(seqs.begin(), seqs.end()), seqs.end());
+  }
+  if (seqs.size() == 1) return seqs.front();
+  if (seqs.empty()) {
+    throw KittiError("no sequence in " + dir +
+                     " (no velodyne/NNNN/, no velodyne_NNNN.tar.zst and no calib/NNNN.txt, nor "
+                     "under training/): name the sequence");
+  }
+  std::string list;
+  for (const auto& s : seqs) list += (list.empty() ? "" : ", ") + s;
+  throw KittiError(dir + " holds several sequences (" + list + "): name the one to read");
 }
 
 std::string DefaultCacheDir() {

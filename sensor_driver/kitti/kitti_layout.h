@@ -18,6 +18,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace vtrack::kitti {
 
@@ -54,6 +55,16 @@ SequencePaths LocateSequence(const std::string& dir, const std::string& sequence
 // that file exists (and refuses a mismatch).
 std::string UnpackVelodyneArchive(const std::string& archive, const std::string& sequence,
                                   const std::string& cache_dir, const MessageSink& sink);
+
+// The sequences of DIR (or DIR/training) that have point clouds: every velodyne/NNNN/ folder and
+// velodyne_NNNN.tar.zst archive, sorted, each once. Empty if DIR holds none.
+std::vector<std::string> PointCloudSequences(const std::string& dir);
+
+// The sequence to read from DIR: `requested` normalised if it is not empty, else the folder's
+// only point-cloud sequence (PointCloudSequences; where there are none, its only calib/NNNN.txt), so that any folder of the same layout (e.g. a
+// held-out kitti_tracking_NNNN) is read without naming its number. Throws KittiError if it is
+// empty and DIR holds no such sequence or several (naming them).
+std::string ResolveSequence(const std::string& dir, const std::string& requested);
 
 // Normalises a sequence name: "0", "00", "0000" -> "0000". Throws KittiError for anything that is
 // not 1-4 decimal digits.

@@ -106,7 +106,7 @@ std::string SequenceOptions::Validate() const {
 
 Sequence::Sequence(SequenceOptions options) : options_(std::move(options)) {
   if (const std::string err = options_.Validate(); !err.empty()) throw KittiError("bad option: " + err);
-  sequence_ = NormaliseSequence(options_.sequence);
+  sequence_ = ResolveSequence(options_.dir, options_.sequence);
   paths_ = LocateSequence(options_.dir, sequence_, options_.poses_file, options_.oxts_file,
                           options_.cache_dir, options_.sink);
   calib_ = ReadCalibration(paths_.calib_file);

@@ -34,7 +34,8 @@ inline constexpr std::int64_t kDefaultStartUtime = 1'316'995'200'000'000;
 
 struct SequenceOptions {
   std::string dir;                 // [-] KITTI folder, standard or packed layout (kitti_layout.h)
-  std::string sequence = "0000";   // [-] sequence number, 1-4 digits
+  std::string sequence;            // [-] sequence number, 1-4 digits; "" = the folder's only
+                                   //     point-cloud sequence (ResolveSequence)
   std::string poses_file;          // [-] KITTI odometry poses (velo i -> velo 0); "" = default
   std::string oxts_file;           // [-] OXTS file instead of poses; "" = default
   std::int64_t start_utime = kDefaultStartUtime;  // [us since epoch] FrameUtime(0); > sweep/2

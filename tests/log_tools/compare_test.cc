@@ -158,6 +158,42 @@ TEST_F(CompareTest, KittiInputModesGiveOneItemEach) {
   }
 }
 
+// A folder of the same layout holding another sequence (a held-out kitti_tracking_NNNN) is scored
+// by the same command: its own sequence is converted, calibrated and named; a folder with two
+// sequences needs --kitti-sequence.
+TEST_F(CompareTest, AKittiFolderOfAnotherSequenceIsScoredUnderItsOwnNumber) {
+  const std::string kitti = dir_ + "/kitti_0007";
+  fs::create_directories(kitti + "/calib");
+  fs::create_directories(kitti + "/label_02");
+  {
+    std::ofstream c(kitti + "/calib/0007.txt");
+    const char* p = "500 0 600 0 0 500 180 0 0 0 1 0";
+    c << "P0: " << p << "\nP1: " << p << "\nP2: " << p << "\nP3: " << p << "\n"
+      << "R0_rect: 1 0 0 0 1 0 0 0 1\nTr_velo_to_cam: 0 -1 0 0 0 0 -1 0 1 0 0 0\n";
+  }
+  std::ofstream(kitti + "/label_02/0007.txt")
+      << "0 -1 DontCare -1 -1 -10 100 100 200 200 -1 -1 -1 -1000 -1000 -1000 -10\n";
+  const std::string json = dir_ + "/seq7.json", calls = dir_ + "/seq7_calls.txt";
+  std::string out;
+  ASSERT_EQ(RunTool({"--kitti", kitti, "--modes", "mht", "--bin-dir", fake_bin_, "--json", json},
+                    &out, {"FAKE_TOOL_LOG=" + calls}), 0) << out;
+  const std::string c = ReadFile(calls);
+  EXPECT_NE(c.find("--sequence 0007 --out run.lcm"), std::string::npos) << c;
+  // Scored with calib/0007.txt (without it the run stops) and label_02/0007.txt's DontCare.
+  const YAML::Node j = YAML::LoadFile(json);
+  ASSERT_TRUE(j["kitti_0007"]["mht"].IsMap());
+  EXPECT_TRUE(j["kitti_0007"]["mht"]["params"]["kitti_dont_care"].as<bool>());
+  EXPECT_FALSE(j["kitti_0000"].IsDefined());
+
+  std::ofstream(kitti + "/calib/0008.txt") << "";
+  EXPECT_EQ(RunTool({"--kitti", kitti, "--modes", "mht", "--bin-dir", fake_bin_}, &out), 2);
+  EXPECT_NE(out.find("several sequences (0007, 0008)"), std::string::npos) << out;
+  ASSERT_EQ(RunTool({"--kitti", kitti, "--kitti-sequence", "7", "--modes", "mht", "--bin-dir",
+                     fake_bin_, "--json", json},
+                    &out, {"FAKE_TOOL_LOG=" + calls}), 0) << out;
+  EXPECT_TRUE(YAML::LoadFile(json)["kitti_0007"]["mht"].IsMap());
+}
+
 TEST_F(CompareTest, AFailedModeIsReportedAndTheRestStillScored) {
   const std::string json = dir_ + "/cmp.json";
   std::string out;

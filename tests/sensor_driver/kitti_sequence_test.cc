@@ -176,6 +176,43 @@ TEST(KittiSequenceTest, SyntheticOxtsGivesVeloPoses) {
   }
 }
 
+TEST(KittiSequenceTest, AFolderWithOneSequenceIsReadWithoutItsNumber) {
+  // A folder of the same layout but another number (a held-out kitti_tracking_NNNN) is read as
+  // it is: its only sequence with point clouds, whatever its number.
+  const SyntheticSequence s = MakeSynthetic("kitti_seq_only_one");
+  SequenceOptions o = OptionsFor(s);
+  o.sequence.clear();
+  const Sequence seq(o);
+  EXPECT_EQ(seq.sequence(), "0000");
+  EXPECT_EQ(seq.num_frames(), s.num_frames);
+
+  namespace fs = std::filesystem;
+  const fs::path d = vtrack::testing::ScratchDir("kitti_seq_listing");
+  EXPECT_TRUE(PointCloudSequences(d.string()).empty());
+  try {
+    ResolveSequence(d.string(), "");
+    ADD_FAILURE() << "a folder without point clouds has no sequence to resolve";
+  } catch (const KittiError& e) {
+    EXPECT_NE(std::string(e.what()).find("no sequence in"), std::string::npos) << e.what();
+  }
+  // Packed archives, unpacked folders and the standard download's training/ all count; a name
+  // that is not four digits does not.
+  std::ofstream(d / "velodyne_0013.tar.zst") << "x";
+  EXPECT_EQ(ResolveSequence(d.string(), ""), "0013");
+  fs::create_directories(d / "training" / "velodyne" / "0004");
+  fs::create_directories(d / "velodyne" / "13");
+  std::ofstream(d / "velodyne_13.tar.zst") << "x";
+  EXPECT_EQ(PointCloudSequences(d.string()), (std::vector<std::string>{"0004", "0013"}));
+  try {
+    ResolveSequence(d.string(), "");
+    ADD_FAILURE() << "two sequences: the number must be given";
+  } catch (const KittiError& e) {
+    EXPECT_NE(std::string(e.what()).find("several sequences (0004, 0013)"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(ResolveSequence(d.string(), "4"), "0004");  // named: taken as given (normalised)
+  EXPECT_EQ(ResolveSequence(d.string(), "0099"), "0099");  // located (or refused) later
+}
+
 TEST(KittiSequenceTest, ErrorsNameWhatIsMissingOrBad) {
   const SyntheticSequence s = MakeSynthetic("kitti_seq_bad");
   SequenceOptions o = OptionsFor(s);

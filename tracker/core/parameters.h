@@ -582,6 +582,9 @@ enum class EvidenceFeature : std::int8_t {
   kSmall,          // [-] 1 if measured by its centroid (small object)
   kLengthUnseen,   // [-] 1 if the hypothesis has no length estimate yet
   kWidthUnseen,    // [-] 1 if it has no width estimate yet (one face seen)
+  kInlierShare,    // [-] share of the fitted returns within the inlier threshold of the fitted
+                   //     faces: a body panel is smooth at the range noise, foliage scatters its
+                   //     returns through its depth; missing (NaN) if the scan gave no fit
   kCount
 };
 
@@ -592,7 +595,7 @@ struct vtrack::EnumNames<vtrack::EvidenceFeature> {
   static constexpr std::array kNames{"log_points", "log_range", "height_max", "height_median",
                                      "height_min", "column_top", "top_beam", "length", "width",
                                      "segment_extent", "hidden_ends", "speed", "mover", "small",
-                                     "length_unseen", "width_unseen"};
+                                     "length_unseen", "width_unseen", "inlier_share"};
 };
 
 namespace vtrack {

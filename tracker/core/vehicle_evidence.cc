@@ -139,6 +139,10 @@ EvidenceFeatures FeaturesOf(const ReturnEvidence& r, const Track& t, double spee
   set(EvidenceFeature::kWidth, sel.width_est.value_or(kMissing));
   set(EvidenceFeature::kLengthUnseen, sel.length_est ? 0.0 : 1.0);
   set(EvidenceFeature::kWidthUnseen, sel.width_est ? 0.0 : 1.0);
+  set(EvidenceFeature::kInlierShare,
+      sel.has_fit && !sel.fit.point_edge.empty()
+          ? static_cast<double>(sel.fit.num_inliers) / static_cast<double>(sel.fit.point_edge.size())
+          : kMissing);
   set(EvidenceFeature::kSegmentExtent, r.segment_extent);
   set(EvidenceFeature::kHiddenEnds, r.hidden_ends);
   // Speed from the reported hypothesis (bounded: a diverging filter says nothing more at 60 m/s).

@@ -48,9 +48,7 @@ ObjectClass Classify(const TrackManagerParams& params, const EvidenceParams& evi
   }
   if (t.box_updates > 0) return confident ? ObjectClass::kVehicle : ObjectClass::kOther;
   if ((t.evidence_3d ? evidence.classifier_3d : evidence.classifier_2d) == VehicleClassifier::kEvidence) {
-    return VehicleProbability(t.vehicle_log_odds) >= evidence.vehicle_probability
-               ? ObjectClass::kVehicle
-               : ObjectClass::kOther;
+    return t.evidence_vehicle ? ObjectClass::kVehicle : ObjectClass::kOther;
   }
   if (t.small_object) return ObjectClass::kOther;
   const TrackHypothesis& sel = t.hyps[static_cast<std::size_t>(t.selected)];

@@ -686,6 +686,7 @@ struct EvidenceParams {
   double scan_weight = evidence_fit::kScanWeight;
   double max_log_odds = 6.0;
   double vehicle_probability = 0.5;
+  double keep_probability = evidence_fit::kKeepProbability;
   EvidenceModel model_3d = evidence_fit::kModel3D;
   double bias_3d = evidence_fit::kBias3D;
   std::vector<EvidenceTerm> terms_3d = evidence_fit::kTerms3D;
@@ -704,7 +705,8 @@ struct EvidenceParams {
     v("accumulation", &accumulation, {"-", {}, "sum: L += scan_weight (l - logit(prior)); average: L += scan_weight (l - L), an exponential average of the scans' log posterior odds (scans of one object are far from independent); fitted (the better log-likelihood)"});
     v("scan_weight", &scan_weight, {"-", OpenClosed(0, 1), "the weight of each scan in the accumulation; fitted"});
     v("max_log_odds", &max_log_odds, {"-", Above(0), "the accumulated log-odds are clamped to +-this, so that a track can change its mind"});
-    v("vehicle_probability", &vehicle_probability, {"-", Open(0, 1), "a track is a vehicle from this accumulated probability on"});
+    v("vehicle_probability", &vehicle_probability, {"-", Open(0, 1), "a track becomes a vehicle when its accumulated probability reaches this (0.5: a report is more likely right than wrong, what MOTA counts)"});
+    v("keep_probability", &keep_probability, {"-", OpenClosed(0, 1), "a vehicle stays one while its accumulated probability is at least this (<= vehicle_probability; a run of weak scans then does not flip it, each flip cost a fragment); fitted: the fewest held-out wrong decisions"});
     v("model_3d", &model_3d, {"-", {}, "3-D scans: logistic (bias_3d + terms_3d) or trees (bias_3d + trees_3d); fitted: the better held-out log-likelihood"});
     v("bias_3d", &bias_3d, {"-", Finite(), "3-D scans: intercept of the per-scan logit"});
     v("terms_3d", &terms_3d, {"-", {}, "3-D scans: the logistic model's terms (fitted)"});
@@ -714,8 +716,8 @@ struct EvidenceParams {
     v("terms_2d", &terms_2d, {"-", {}, "single-plane scans: the logistic model's terms (fitted)"});
     v("trees_2d", &trees_2d, {"-", {}, "single-plane scans: the boosted trees' nodes (fitted)"});
   }
-  // The chosen family's list is not empty; each tree's children lie after their parent, in the
-  // list and in the same tree.
+  // keep_probability <= vehicle_probability; the chosen family's list is not empty; each tree's
+  // children lie after their parent, in the list and in the same tree.
   std::string CrossProblem() const;
   bool Validate(std::string* error) const { return param::Validate(*this, error); }
 };

@@ -379,6 +379,7 @@ double TrackManager::ObserveEvidence(std::size_t index, const ReturnEvidence& r,
   const EvidenceFeatures f = FeaturesOf(r, t, ekf_.Centre(sel.filter).speed);
   const double logit = ScanLogit(evidence_, r.three_d, f);
   t.vehicle_log_odds = AccumulateLogOdds(evidence_, t.vehicle_log_odds, logit);
+  t.evidence_vehicle = VehicleByEvidence(evidence_, t.evidence_vehicle, t.vehicle_log_odds);
   t.evidence_3d = r.three_d;
   if (features != nullptr) *features = f;
   return logit;

@@ -209,6 +209,10 @@ std::string TreeProblem(const char* key, const std::vector<EvidenceNode>& list) 
 }  // namespace
 
 std::string EvidenceParams::CrossProblem() const {
+  if (!(keep_probability <= vehicle_probability)) {
+    return param::Problem("keep_probability", keep_probability, "-",
+                          "<= vehicle_probability (" + std::to_string(vehicle_probability) + ")");
+  }
   // The fitted defaults hold the chosen family only: the other one's list is empty, and a model
   // switched to it would be its bias alone, the same probability for every track.
   for (const bool three_d : {true, false}) {
@@ -252,5 +256,9 @@ double AccumulateLogOdds(const EvidenceParams& p, double log_odds, double scan_l
 }
 
 double VehicleProbability(double log_odds) { return 1.0 / (1.0 + std::exp(-log_odds)); }
+
+bool VehicleByEvidence(const EvidenceParams& p, bool was_vehicle, double log_odds) {
+  return VehicleProbability(log_odds) >= (was_vehicle ? p.keep_probability : p.vehicle_probability);
+}
 
 }  // namespace vtrack

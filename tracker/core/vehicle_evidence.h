@@ -98,4 +98,9 @@ double AccumulateLogOdds(const EvidenceParams& p, double log_odds, double scan_l
 // sigmoid(L).
 double VehicleProbability(double log_odds);
 
+// Whether a track is a vehicle by its accumulated log-odds L, with hysteresis: one that was
+// (was_vehicle) stays one while sigmoid(L) >= keep_probability, another becomes one when
+// sigmoid(L) >= vehicle_probability.
+bool VehicleByEvidence(const EvidenceParams& p, bool was_vehicle, double log_odds);
+
 }  // namespace vtrack

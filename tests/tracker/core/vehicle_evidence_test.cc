@@ -100,6 +100,52 @@ TEST(VehicleEvidence, AnUnestimatedDimensionIsMissingNotZero) {
   EXPECT_NEAR(ScanLogit(p, false, f), -1.0 + 2.0 - 3.0 + 0.5 + (-0.5) * (-0.5), 1e-12);
 }
 
+// inlier_share: the share of the fitted returns that the fit counted as inliers; missing when the
+// scan gave no fit (a small object's centroid, a failed fit).
+TEST(VehicleEvidence, InlierShareIsTheFitsInliersOverItsReturnsAndMissingWithoutAFit) {
+  Track t;
+  t.hyps.resize(1);
+  t.selected = 0;
+  TrackHypothesis& h = t.hyps[0];
+  h.fit.point_edge.assign(40, FitResult::kOutlier);
+  h.fit.num_inliers = 30;
+  ReturnEvidence r;
+  r.num_points = 40;
+  const auto k = static_cast<std::size_t>(EvidenceFeature::kInlierShare);
+  EXPECT_TRUE(std::isnan(FeaturesOf(r, t, 0.0)[k]));  // has_fit false: this scan gave no fit
+  h.has_fit = true;
+  EXPECT_DOUBLE_EQ(FeaturesOf(r, t, 0.0)[k], 0.75);
+  h.fit.point_edge.clear();
+  EXPECT_TRUE(std::isnan(FeaturesOf(r, t, 0.0)[k]));
+}
+
+// The decision has hysteresis: a track becomes a vehicle at vehicle_probability and stays one
+// down to keep_probability; below that it is other until it reaches vehicle_probability again.
+TEST(VehicleEvidence, AVehicleStaysOneDownToTheKeepProbability) {
+  EvidenceParams p;
+  p.vehicle_probability = 0.5;
+  p.keep_probability = 0.3;
+  auto L = [](double prob) { return std::log(prob / (1.0 - prob)); };
+  EXPECT_FALSE(VehicleByEvidence(p, false, L(0.45)));
+  EXPECT_TRUE(VehicleByEvidence(p, false, L(0.5)));
+  EXPECT_TRUE(VehicleByEvidence(p, true, L(0.45)));
+  EXPECT_TRUE(VehicleByEvidence(p, true, L(0.3000001)));
+  EXPECT_FALSE(VehicleByEvidence(p, true, L(0.2999999)));
+  // Through a track's life: 0.6 (becomes one), 0.35 (stays), 0.25 (leaves), 0.45 (not yet).
+  bool v = false;
+  std::vector<bool> seen;
+  for (const double prob : {0.2, 0.6, 0.35, 0.25, 0.45, 0.55}) {
+    v = VehicleByEvidence(p, v, L(prob));
+    seen.push_back(v);
+  }
+  EXPECT_EQ(seen, (std::vector<bool>{false, true, true, false, false, true}));
+  // keep_probability above vehicle_probability would be no hysteresis but a gap: refused.
+  p.keep_probability = 0.6;
+  std::string error;
+  EXPECT_FALSE(p.Validate(&error));
+  EXPECT_NE(error.find("keep_probability"), std::string::npos) << error;
+}
+
 // A boosted ensemble: the logit is the bias plus the leaf each tree sends the scan to, a missing
 // feature going left; a list whose children do not follow their parent in the same tree is refused.
 TEST(VehicleEvidence, TreesSumTheLeavesTheScanReachesAndSendMissingFeaturesLeft) {

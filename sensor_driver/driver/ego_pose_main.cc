@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
     auto t = std::make_unique<vtrack::sim::KittiPoseTimeline>(vtrack::sim::KittiCliOptions(vm),
                                                               rate, lcm, channel);
     std::fprintf(stderr, "vtrack-ego-pose: KITTI sequence %s, %d poses at %.0f Hz per run\n",
-                 vm["sequence"].as<std::string>().c_str(), t->Count(), rate);
+                 t->Sequence().c_str(), t->Count(), rate);
     return t;
   };
 #endif

@@ -27,6 +27,8 @@ kitti::SequenceOptions KittiCliOptions(const boost::program_options::variables_m
 class KittiTimeline : public Timeline {
  public:
   std::int64_t LapUs() const override;  // num_frames * 100 ms
+  // The sequence read (NNNN; the folder's only one when none was named).
+  const std::string& Sequence() const { return seq().sequence(); }
 
  protected:
   // Throws kitti::KittiError for a missing or malformed sequence.

@@ -59,7 +59,7 @@ int main(int argc, char** argv) {
     auto t = std::make_unique<vtrack::sim::KittiScanTimeline>(
         vtrack::sim::KittiCliOptions(vm), lcm, output, truth_channel, detections_channel);
     std::fprintf(stderr, "vtrack-ladar-driver: KITTI sequence %s, %d frames\n",
-                 vm["sequence"].as<std::string>().c_str(), t->Count());
+                 t->Sequence().c_str(), t->Count());
     return t;
   };
 #endif

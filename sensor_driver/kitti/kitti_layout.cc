@@ -150,6 +150,7 @@ std::string NormaliseSequence(const std::string& sequence) {
 
 std::vector<std::string> PointCloudSequences(const std::string& dir) {
   std::vector<std::string> out;
+  if (dir.empty()) return out;  // not the current directory
   for (const fs::path& root : {fs::path(dir), fs::path(dir) / "training"}) {
     std::error_code ec;
     if (!fs::is_directory(root, ec)) continue;
@@ -196,11 +197,13 @@ std::string ResolveSequence(const std::string& dir, const std::string& requested
   if (seqs.empty()) {
     throw KittiError("no sequence in " + dir +
                      " (no velodyne/NNNN/, no velodyne_NNNN.tar.zst and no calib/NNNN.txt, nor "
-                     "under training/): name the sequence");
+                     "under training/): name the sequence (--sequence; vtrack-compare: "
+                     "--kitti-sequence)");
   }
   std::string list;
   for (const auto& s : seqs) list += (list.empty() ? "" : ", ") + s;
-  throw KittiError(dir + " holds several sequences (" + list + "): name the one to read");
+  throw KittiError(dir + " holds several sequences (" + list +
+                   "): name the one to read (--sequence; vtrack-compare: --kitti-sequence)");
 }
 
 std::string DefaultCacheDir() {

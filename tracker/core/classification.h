@@ -31,9 +31,10 @@ class MoverTest {
 };
 
 // The class of t. A track a detector's box measured: from its boxes (below). Otherwise, with
-// evidence.classifier_3d (classifier_2d for tracks seen by single-plane scans) = evidence: a
-// vehicle from an accumulated vehicle probability of
-// evidence.vehicle_probability on (vehicle_evidence.h). With the rules: a vehicle if its
+// evidence.classifier_3d (classifier_2d for tracks seen by single-plane scans) = evidence: as its
+// accumulated vehicle evidence decides (Track::evidence_vehicle, VehicleByEvidence: a vehicle from
+// evidence.vehicle_probability on, and one stays a vehicle down to evidence.keep_probability;
+// vehicle_evidence.h). With the rules: a vehicle if its
 // estimated size (not the default lower bound) fits a vehicle, or a face of a car's front or rear
 // width was seen whole and the rest fits, or it is a mover of any plausible size; small objects
 // are other.

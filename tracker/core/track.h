@@ -67,6 +67,7 @@ struct Track {
   double box_z = 0.0, box_height = 0.0;   // [m] the same mean of their bottom (world) and height
   double vehicle_log_odds = 0.0;          // [-] accumulated vehicle evidence (vehicle_evidence.h)
   bool evidence_vehicle = false;          // [-] a vehicle by that evidence (VehicleByEvidence)
+  bool evidence_seen = false;             // [-] a scan has given it evidence
   bool evidence_3d = false;               // [-] the latest scan evidence came from a 3-D cloud
   std::vector<TrackHypothesis> hyps;
   int selected = 0;                       // index into hyps of the reported hypothesis

@@ -360,7 +360,7 @@ void TrackManager::AddTrack(Track t, TrackHypothesis h, std::int64_t utime) {
   t.state_utime = utime;
   t.last_update_utime = utime;
   t.num_updates = 1;
-  t.vehicle_log_odds = PriorLogOdds(evidence_);
+  t.vehicle_log_odds = PriorLogOdds(evidence_, /*three_d=*/true);
   t.hyps.push_back(std::move(h));
   tracks_.push_back(std::move(t));
 }
@@ -378,7 +378,10 @@ double TrackManager::ObserveEvidence(std::size_t index, const ReturnEvidence& r,
   const TrackHypothesis& sel = t.hyps[static_cast<std::size_t>(t.selected)];
   const EvidenceFeatures f = FeaturesOf(r, t, ekf_.Centre(sel.filter).speed);
   const double logit = ScanLogit(evidence_, r.three_d, f);
-  t.vehicle_log_odds = AccumulateLogOdds(evidence_, t.vehicle_log_odds, logit);
+  // The first evidence: the track starts at the prior of the model that measured it.
+  if (!t.evidence_seen) t.vehicle_log_odds = PriorLogOdds(evidence_, r.three_d);
+  t.evidence_seen = true;
+  t.vehicle_log_odds = AccumulateLogOdds(evidence_, r.three_d, t.vehicle_log_odds, logit);
   t.evidence_vehicle = VehicleByEvidence(evidence_, t.evidence_vehicle, t.vehicle_log_odds);
   t.evidence_3d = r.three_d;
   if (features != nullptr) *features = f;

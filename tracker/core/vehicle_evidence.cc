@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <string>
 
 #include "tracker/core/preprocess.h"
@@ -210,8 +211,11 @@ std::string TreeProblem(const char* key, const std::vector<EvidenceNode>& list) 
 
 std::string EvidenceParams::CrossProblem() const {
   if (!(keep_probability <= vehicle_probability)) {
-    return param::Problem("keep_probability", keep_probability, "-",
-                          "<= vehicle_probability (" + std::to_string(vehicle_probability) + ")");
+    std::ostringstream why;
+    why << "<= vehicle_probability (" << vehicle_probability
+        << "): a vehicle stays one down to keep_probability (fitted default "
+        << evidence_fit::kKeepProbability << "); lower it with vehicle_probability";
+    return param::Problem("keep_probability", keep_probability, "-", why.str());
   }
   // The fitted defaults hold the chosen family only: the other one's list is empty, and a model
   // switched to it would be its bias alone, the same probability for every track.
@@ -247,10 +251,14 @@ double ScanLogit(const EvidenceParams& p, bool three_d, const EvidenceFeatures& 
   return l;
 }
 
-double PriorLogOdds(const EvidenceParams& p) { return std::log(p.prior / (1.0 - p.prior)); }
+double PriorLogOdds(const EvidenceParams& p, bool three_d) {
+  const double prior = three_d ? p.prior : p.prior_2d;
+  return std::log(prior / (1.0 - prior));
+}
 
-double AccumulateLogOdds(const EvidenceParams& p, double log_odds, double scan_logit) {
-  const double from = p.accumulation == EvidenceAccumulation::kSum ? PriorLogOdds(p) : log_odds;
+double AccumulateLogOdds(const EvidenceParams& p, bool three_d, double log_odds, double scan_logit) {
+  const double from =
+      p.accumulation == EvidenceAccumulation::kSum ? PriorLogOdds(p, three_d) : log_odds;
   const double l = log_odds + p.scan_weight * (scan_logit - from);
   return std::clamp(l, -p.max_log_odds, p.max_log_odds);
 }

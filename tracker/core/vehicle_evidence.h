@@ -5,21 +5,24 @@
 // the returns' height profile above the local ground (3-D clouds), their number and range, how
 // high their columns reach (crowns and building fronts above max_height), the extent of the
 // segment they belong to, how many of their ends are hidden, and the track's own footprint and
-// motion. A per-scan model gives the scan's log posterior odds at the fitting set's prior pi:
+// motion. A per-scan model gives the scan's log posterior odds at its fitting set's prior pi
+// (`prior` for the 3-D model, `prior_2d` for the single-plane one):
 // boosted trees, l(f) = bias + the sum over the trees of the leaf f reaches (a missing feature
 // goes left at every split), or a logistic model,
 //   l(f) = bias + sum_k w_k ((f_k - c_k) / s_k)^p_k,
 // where a missing feature (a length or width not estimated yet: NaN) adds nothing, i.e. sits at
 // its training mean c_k, and an indicator feature says that it is missing;
 // one model for 3-D clouds and one for single-plane scans (which measure no heights). The
-// track's log-odds L start at logit(pi); each scan moves them by scan_weight a, either adding
+// track's log-odds L start at logit(pi) of the model that first measures it; each scan moves them by scan_weight a, either adding
 // its log-likelihood ratio (accumulation: sum) or moving towards its log posterior odds
 // (average, an exponential average: successive scans of one object are strongly correlated, and
 // a sum of their ratios turns a run of weak evidence into certainty):
 //   sum:     L <- clamp(L + a (l(f) - logit(pi)), -max_log_odds, +max_log_odds),
 //   average: L <- clamp(L + a (l(f) - L), ...),
-// and the track's vehicle probability is sigmoid(L). The terms, pi, the accumulation and a are
-// fitted by scripts/fit-vehicle-evidence; nothing here is tuned by hand.
+// and the track's vehicle probability is sigmoid(L). It is a vehicle from vehicle_probability on
+// and stays one down to keep_probability (VehicleByEvidence). The terms, the priors, the
+// accumulation, a and keep_probability are fitted by scripts/fit-vehicle-evidence; nothing here is
+// tuned by hand.
 #pragma once
 
 #include <array>
@@ -89,11 +92,12 @@ bool UsesFeature(const EvidenceParams& p, bool three_d, EvidenceFeature k);
 // The scan's logit l(f) under the 3-D or the single-plane model.
 double ScanLogit(const EvidenceParams& p, bool three_d, const EvidenceFeatures& f);
 
-// logit(prior): where every track starts.
-double PriorLogOdds(const EvidenceParams& p);
+// logit(prior) of the 3-D or the single-plane model (prior, prior_2d): where a track starts, at
+// the prior of the model its first evidence comes from (before any: the 3-D one).
+double PriorLogOdds(const EvidenceParams& p, bool three_d);
 
-// L after one more scan with logit l.
-double AccumulateLogOdds(const EvidenceParams& p, double log_odds, double scan_logit);
+// L after one more scan with logit l of the 3-D or the single-plane model.
+double AccumulateLogOdds(const EvidenceParams& p, bool three_d, double log_odds, double scan_logit);
 
 // sigmoid(L).
 double VehicleProbability(double log_odds);

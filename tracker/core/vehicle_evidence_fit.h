@@ -7,6 +7,7 @@
 namespace vtrack::evidence_fit {
 
 inline constexpr double kPrior = 0.210870988;
+inline constexpr double kPrior2D = 0.446615445;
 inline constexpr double kScanWeight = 0.7;
 inline constexpr double kKeepProbability = 0.3;
 inline constexpr EvidenceAccumulation kAccumulation = EvidenceAccumulation::kAverage;
@@ -765,7 +766,7 @@ inline const std::vector<EvidenceNode> kTrees3D = {
     {49, EvidenceFeature::kLogPoints, 0, -1, -1, -0.11603177},
 };
 inline constexpr EvidenceModel kModel2D = EvidenceModel::kTrees;
-inline constexpr double kBias2D = -1.31968331;
+inline constexpr double kBias2D = -0.214355236;
 inline const std::vector<EvidenceTerm> kTerms2D = {
 };
 inline const std::vector<EvidenceNode> kTrees2D = {

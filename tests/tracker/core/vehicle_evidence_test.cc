@@ -42,22 +42,22 @@ TEST(VehicleEvidence, LogitIsTheSumOfItsTermsAndAccumulationIsDiscountedAndClamp
   EXPECT_NEAR(ScanLogit(p, false, f), 0.0, 1e-12);  // no single-plane terms: bias_2d only
 
   const double l0 = std::log(0.2 / 0.8);
-  EXPECT_NEAR(PriorLogOdds(p), l0, 1e-12);
+  EXPECT_NEAR(PriorLogOdds(p, true), l0, 1e-12);
   // n scans of logit 1: L = l0 + n a (1 - l0) until the clamp at +3.
-  double L = PriorLogOdds(p);
+  double L = PriorLogOdds(p, true);
   for (int n = 1; n <= 20; ++n) {
-    L = AccumulateLogOdds(p, L, 1.0);
+    L = AccumulateLogOdds(p, true, L, 1.0);
     EXPECT_NEAR(L, std::min(3.0, l0 + n * 0.25 * (1.0 - l0)), 1e-12) << n;
   }
   // ... and from the clamp, scans of logit -5 bring it down as fast as the clamp allows.
-  L = AccumulateLogOdds(p, L, -5.0);
+  L = AccumulateLogOdds(p, true, L, -5.0);
   EXPECT_NEAR(L, 3.0 + 0.25 * (-5.0 - l0), 1e-12);
   // Averaging: L moves a quarter of the way to each scan's logit: after n scans of logit 1 from
   // l0, L = 1 + (l0 - 1) 0.75^n.
   p.accumulation = EvidenceAccumulation::kAverage;
-  L = PriorLogOdds(p);
+  L = PriorLogOdds(p, true);
   for (int n = 1; n <= 20; ++n) {
-    L = AccumulateLogOdds(p, L, 1.0);
+    L = AccumulateLogOdds(p, true, L, 1.0);
     EXPECT_NEAR(L, 1.0 + (l0 - 1.0) * std::pow(0.75, n), 1e-12) << n;
   }
   EXPECT_NEAR(VehicleProbability(0.0), 0.5, 1e-15);
@@ -314,6 +314,48 @@ TEST(VehicleEvidence, TopRingIsTheHighestBeamWhicheverWayRingsAreNumbered) {
   flat.z = {0.0f};
   flat.ring = {0};
   EXPECT_EQ(TopRing(flat), -1);
+}
+
+// Through the track manager: scans whose evidence drops to p = 0.4 keep a vehicle reported as a
+// vehicle (keep_probability 0.3); at p = 0.2 it becomes other, and p = 0.4 does not bring it back.
+TEST(VehicleEvidence, TheManagerReportsAVehicleWhileItsEvidenceStaysAboveKeep) {
+  TrackerParams p;
+  p.evidence.classifier_3d = VehicleClassifier::kEvidence;
+  p.evidence.model_3d = EvidenceModel::kLogistic;
+  p.evidence.terms_3d.clear();
+  p.evidence.accumulation = EvidenceAccumulation::kAverage;
+  p.evidence.scan_weight = 1.0;  // L is the last scan's logit: each step sets the probability
+  p.evidence.vehicle_probability = 0.5;
+  p.evidence.keep_probability = 0.3;
+  const Ekf ekf(p.ism, p.vasm, p.ekf, p.cv);
+  TrackManager manager(p.manager, ekf, p.fit, p.shape);
+  PointSet pts;
+  pts.origin = Eigen::Vector2d(10.0, 5.0);
+  for (int i = 0; i < 6; ++i) {
+    pts.x.push_back(0.1f * static_cast<float>(i));
+    pts.y.push_back(0.05f * static_cast<float>(i % 2));
+  }
+  pts.extent = std::hypot(0.5, 0.05);
+  pts.mean_utime = 1'000'000;
+  manager.SetEvidence(p.evidence);
+  ASSERT_TRUE(manager.Create(pts, Eigen::Vector2d::Zero(), 1));
+  ReturnEvidence r;
+  r.three_d = true;
+  r.num_points = 6;
+  r.range = 11.0;
+  std::vector<ObjectClass> seen;
+  for (const double prob : {0.6, 0.4, 0.35, 0.2, 0.4, 0.7}) {
+    p.evidence.bias_3d = std::log(prob / (1.0 - prob));  // every scan's logit
+    manager.SetEvidence(p.evidence);
+    manager.ObserveEvidence(0, r);
+    std::vector<TrackReport> out;
+    manager.Report(1'000'000, &out);
+    ASSERT_EQ(out.size(), 1u);
+    EXPECT_NEAR(out[0].vehicle_probability, prob, 1e-9);
+    seen.push_back(out[0].object_class);
+  }
+  const ObjectClass V = ObjectClass::kVehicle, O = ObjectClass::kOther;
+  EXPECT_EQ(seen, (std::vector<ObjectClass>{V, V, V, O, O, V}));
 }
 
 }  // namespace

@@ -358,6 +358,50 @@ TEST(VehicleEvidence, TheManagerReportsAVehicleWhileItsEvidenceStaysAboveKeep) {
   EXPECT_EQ(seen, (std::vector<ObjectClass>{V, V, V, O, O, V}));
 }
 
+// Each model's logits are posteriors at its own prior: a track starts at the prior of the model
+// that first measures it (prior for 3-D scans, prior_2d for single-plane ones), and with
+// accumulation sum each scan's ratio is taken against that model's prior.
+TEST(VehicleEvidence, ATrackStartsAtThePriorOfTheModelThatFirstMeasuresIt) {
+  TrackerParams p;
+  p.evidence.model_3d = p.evidence.model_2d = EvidenceModel::kLogistic;
+  p.evidence.terms_3d.clear();
+  p.evidence.terms_2d.clear();
+  p.evidence.prior = 0.2;
+  p.evidence.prior_2d = 0.6;
+  p.evidence.bias_3d = 1.0;
+  p.evidence.bias_2d = -0.5;
+  p.evidence.accumulation = EvidenceAccumulation::kSum;
+  p.evidence.scan_weight = 0.5;
+  const double l3 = std::log(0.2 / 0.8), l2 = std::log(0.6 / 0.4);
+  EXPECT_NEAR(PriorLogOdds(p.evidence, true), l3, 1e-12);
+  EXPECT_NEAR(PriorLogOdds(p.evidence, false), l2, 1e-12);
+  for (const bool three_d : {true, false}) {
+    const Ekf ekf(p.ism, p.vasm, p.ekf, p.cv);
+    TrackManager manager(p.manager, ekf, p.fit, p.shape);
+    manager.SetEvidence(p.evidence);
+    PointSet pts;
+    pts.origin = Eigen::Vector2d(10.0, 5.0);
+    for (int i = 0; i < 6; ++i) {
+      pts.x.push_back(0.1f * static_cast<float>(i));
+      pts.y.push_back(0.05f * static_cast<float>(i % 2));
+    }
+    pts.extent = std::hypot(0.5, 0.05);
+    pts.mean_utime = 1'000'000;
+    ASSERT_TRUE(manager.Create(pts, Eigen::Vector2d::Zero(), 1));
+    ReturnEvidence r;
+    r.three_d = three_d;
+    r.num_points = 6;
+    r.range = 11.0;
+    const double start = three_d ? l3 : l2, bias = three_d ? 1.0 : -0.5;
+    double expected = start;
+    for (int k = 0; k < 3; ++k) {  // sum: L += a (l - logit(prior of this model))
+      manager.ObserveEvidence(0, r);
+      expected += 0.5 * (bias - start);
+      EXPECT_NEAR(manager.tracks()[0].vehicle_log_odds, expected, 1e-12) << three_d << ' ' << k;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace vtrack
 

@@ -167,6 +167,7 @@ double JsonNumber(const std::string& json, const std::string& key) {
 struct Score {
   double mota = NAN, mota_coasting = NAN;
   int id_switches = -1, id_switches_coasting = -1;
+  int tracks_on_truth = -1;  // scored tracks (coasting ones too) matched to a truth object at least once
 };
 
 // vtrack-eval of the recorded TRACKS against the lossless truth of the same lap: confirmed
@@ -177,9 +178,22 @@ Score Evaluate(const std::string& dir, const std::string& truth_log, const std::
   const std::string j1 = tracks_log + ".json", j2 = tracks_log + ".coasting.json";
   EXPECT_EQ(RunCommand({Bin("vtrack-eval"), truth_log, tracks_log, "--json", j1, "-q"}, dir + "/eval.txt"), 0)
       << ReadFile(dir + "/eval.txt");
-  EXPECT_EQ(RunCommand({Bin("vtrack-eval"), truth_log, tracks_log, "--json", j2, "--score-coasting", "-q"},
+  const std::string csv = tracks_log + ".coasting.csv";
+  EXPECT_EQ(RunCommand({Bin("vtrack-eval"), truth_log, tracks_log, "--json", j2, "--score-coasting",
+                        "--csv", csv, "-q"},
                        dir + "/eval.txt"), 0)
       << ReadFile(dir + "/eval.txt");
+  // The per-track CSV: track_id,first_s,last_s,scans,matched,...
+  std::istringstream rows(ReadFile(csv));
+  std::string row;
+  std::getline(rows, row);  // header
+  s.tracks_on_truth = 0;
+  while (std::getline(rows, row)) {
+    std::istringstream fields(row);
+    std::string f;
+    for (int k = 0; k < 5 && std::getline(fields, f, ','); ++k) {}
+    if (!f.empty() && std::stol(f) > 0) ++s.tracks_on_truth;
+  }
   const std::string a = ReadFile(j1), b = ReadFile(j2);
   s.mota = JsonNumber(a, "mota");
   s.mota_coasting = JsonNumber(b, "mota");
@@ -269,11 +283,11 @@ std::vector<LossRun> RunLoss(const std::string& dir, const std::string& scenario
     const double p = percent[i] / 100.0;
     std::printf("%s, loss %d%% of datagrams (%.1f per scan: a whole scan arrives with P = %.3f): %ld datagrams "
                 "dropped; scans published %d, received %lld, counted lost (scan_seq_gap) %lld, processed "
-                "%lld; MOTA %.3f (coasting tracks scored: %.3f), id switches %d (%d), tracks scored %d\n",
+                "%lld; MOTA %.3f (coasting tracks scored: %.3f), id switches %d (%d), tracks scored %d (on a truth object %d)\n",
                 scenario.c_str(), percent[i], r.datagrams_per_scan, std::pow(1 - p, r.datagrams_per_scan),
                 r.datagrams_dropped, published, static_cast<long long>(r.status.scans_received),
                 static_cast<long long>(gaps), static_cast<long long>(r.status.scans_processed), r.score.mota,
-                r.score.mota_coasting, r.score.id_switches, r.score.id_switches_coasting, r.scored_tracks);
+                r.score.mota_coasting, r.score.id_switches, r.score.id_switches_coasting, r.scored_tracks, r.score.tracks_on_truth);
     // Kept running to the end, and the loss is counted: received + counted gaps = published, up
     // to scans lost before the first or after the last received one (no gap to see).
     EXPECT_GT(r.status.scans_received, 0);
@@ -312,13 +326,15 @@ TEST(FaultTest, DatagramLossTrackerCoastsKeepsItsTracksAndCountsTheLoss) {
     }
   }
   // The tracks are kept through the loss: (nearly) the clean run's MOTA with coasting tracks
-  // scored, no identity switch and no track re-created beyond the clean run's.
+  // scored, no identity switch and no track re-created beyond the clean run's (a track on a truth
+  // object; a short-lived false positive, e.g. a piece of clutter classed vehicle for 0.3 s in one
+  // 5% run, is counted by the MOTA bound instead).
   EXPECT_GT(runs[0].score.mota_coasting, 0.0);
   EXPECT_GE(runs[1].score.mota_coasting, runs[0].score.mota_coasting - 0.05);
   EXPECT_GE(runs[2].score.mota_coasting, runs[0].score.mota_coasting - 0.10);
   for (int i : {1, 2}) {
     EXPECT_LE(runs[i].score.id_switches_coasting, runs[0].score.id_switches_coasting);
-    EXPECT_LE(runs[i].scored_tracks, runs[0].scored_tracks);
+    EXPECT_LE(runs[i].score.tracks_on_truth, runs[0].score.tracks_on_truth);
   }
 }
 

@@ -162,8 +162,9 @@ void PoolMeans(const std::vector<std::pair<const std::vector<double>*, const std
 
 // The CLEAR MOT counts of every sequence summed (MOTA recomputed from them, MOTP weighted by
 // the matches), and the prediction errors (all, turning, straight) weighted by their samples;
-// the rest is not summed.
-EvalSummary SumOf(const std::vector<const EvalSummary*>& parts) {
+// mean_hota: HOTA and its parts the mean over the parts (runs of one scenario), else NaN (the
+// boxes sequences: their sum is not a HOTA); the rest is not summed.
+EvalSummary SumOf(const std::vector<const EvalSummary*>& parts, bool mean_hota) {
   EvalSummary s;
   double motp_sum = 0.0;
   std::vector<double> pred_sum;
@@ -216,6 +217,15 @@ EvalSummary SumOf(const std::vector<const EvalSummary*>& parts) {
   PoolMeans(straight, &s.prediction_error_straight_m, &s.prediction_samples_straight);
   if (!parts.empty()) s.params = parts.front()->params;  // the horizons, for the JSON
   s.hota.hota = s.hota.deta = s.hota.assa = s.hota.loca = nan;
+  if (mean_hota && !parts.empty()) {
+    s.hota.hota = s.hota.deta = s.hota.assa = s.hota.loca = 0.0;
+    for (const EvalSummary* p : parts) {
+      s.hota.hota += p->hota.hota / static_cast<double>(parts.size());
+      s.hota.deta += p->hota.deta / static_cast<double>(parts.size());
+      s.hota.assa += p->hota.assa / static_cast<double>(parts.size());
+      s.hota.loca += p->hota.loca / static_cast<double>(parts.size());
+    }
+  }
   s.position_rmse_m = s.heading_rmse_deg = s.heading_flip_fraction = nan;
   s.speed_rmse_mps = s.yaw_rate_rmse_dps = s.rear_axle_rmse_m = nan;
   s.nees_mean = s.nees_within_95 = nan;
@@ -250,6 +260,27 @@ CompareItem ScenarioItem(const std::string& name_or_path) {
   item.name = fs::path(name_or_path).stem().string();
   if (item.name.empty()) throw std::invalid_argument("empty scenario name in --scenarios");
   return item;
+}
+
+std::vector<CompareItem> ScenarioSeedItems(const CompareItem& scenario,
+                                           const std::vector<std::int64_t>& seeds) {
+  if (seeds.empty()) throw std::invalid_argument("no seed");
+  std::vector<CompareItem> out;
+  for (const std::int64_t seed : seeds) {
+    CompareItem item = scenario;
+    item.seed = seed;
+    if (seeds.size() > 1) {
+      item.name = scenario.name + "_seed" + std::to_string(seed);
+      item.sum_row = scenario.name + "_seeds";
+    }
+    for (const CompareItem& other : out) {
+      if (other.seed == seed) {
+        throw std::invalid_argument("seed " + std::to_string(seed) + " given twice");
+      }
+    }
+    out.push_back(item);
+  }
+  return out;
 }
 
 int RunCompare(const CompareOptions& o) {
@@ -326,7 +357,7 @@ int RunCompare(const CompareOptions& o) {
       std::vector<std::string> argv;
       if (item.kind == CompareItem::Kind::kScenario) {
         argv = {tool("vtrack-sim-log"), "--scenario", item.source, "--out", run, "--seed",
-                std::to_string(o.seed)};
+                std::to_string(item.seed)};
       } else if (item.kind == CompareItem::Kind::kKitti) {
         argv = {tool("vtrack-kitti2lcm"), "--kitti", item.source, "--sequence", item.sequence,
                 "--out", run};
@@ -442,32 +473,36 @@ int RunCompare(const CompareOptions& o) {
     }
   }
 
-  // The table, in the order given; the boxes sequences summed per mode.
+  // The table, in the order given; each summed row (CompareItem::sum_row) after its last item,
+  // per mode.
   std::vector<TableRow> rows;
-  std::map<std::string, EvalSummary> box_sums;
-  bool any_boxes = false;
-  for (const CompareItem& item : o.items) {
+  std::vector<std::string> sum_rows;  // in order of their last item
+  std::map<std::string, std::map<std::string, EvalSummary>> sums;  // [sum row][mode]
+  for (std::size_t k = 0; k < o.items.size(); ++k) {
+    const CompareItem& item = o.items[k];
     for (const std::string& mode : o.modes) {
       const auto it = results.find(item.name);
       const EvalSummary* s = nullptr;
       if (it != results.end() && it->second.count(mode)) s = &it->second.at(mode);
       rows.push_back({item.name, mode, s});
     }
-    any_boxes = any_boxes || item.kind == CompareItem::Kind::kKittiBoxes;
-  }
-  if (any_boxes) {
+    if (item.sum_row.empty()) continue;
+    bool last = true;
+    for (std::size_t l = k + 1; l < o.items.size(); ++l) last = last && o.items[l].sum_row != item.sum_row;
+    if (!last) continue;
+    sum_rows.push_back(item.sum_row);
     for (const std::string& mode : o.modes) {
       std::vector<const EvalSummary*> parts;
-      for (const CompareItem& item : o.items) {
-        const auto it = results.find(item.name);
-        if (item.kind == CompareItem::Kind::kKittiBoxes && it != results.end() && it->second.count(mode)) {
-          parts.push_back(&it->second.at(mode));
-        }
+      bool scenarios = true;
+      for (const CompareItem& part : o.items) {
+        if (part.sum_row != item.sum_row) continue;
+        scenarios = scenarios && part.kind == CompareItem::Kind::kScenario;
+        const auto it = results.find(part.name);
+        if (it != results.end() && it->second.count(mode)) parts.push_back(&it->second.at(mode));
       }
-      if (!parts.empty()) box_sums[mode] = SumOf(parts);
-    }
-    for (const std::string& mode : o.modes) {
-      rows.push_back({"kitti_boxes_sum", mode, box_sums.count(mode) ? &box_sums.at(mode) : nullptr});
+      if (!parts.empty()) sums[item.sum_row][mode] = SumOf(parts, scenarios);
+      const auto& row_sums = sums[item.sum_row];
+      rows.push_back({item.sum_row, mode, row_sums.count(mode) ? &row_sums.at(mode) : nullptr});
     }
   }
   std::cout << ComparisonTable(rows) << std::flush;
@@ -530,12 +565,13 @@ int RunCompare(const CompareOptions& o) {
       }
       w.EndObject();
     }
-    if (any_boxes) {
-      w.Key("kitti_boxes_sum").BeginObject();
+    for (const std::string& row : sum_rows) {
+      const auto& row_sums = sums[row];
+      w.Key(row).BeginObject();
       for (const std::string& mode : o.modes) {
         w.Key(mode);
-        if (box_sums.count(mode)) {
-          std::string js = SummaryJson(box_sums.at(mode));
+        if (row_sums.count(mode)) {
+          std::string js = SummaryJson(row_sums.at(mode));
           while (!js.empty() && js.back() == '\n') js.pop_back();
           w.Raw(js);
         } else {

@@ -1,7 +1,11 @@
 // vtrack-compare: the tracker's three modes side by side on scenarios and real data.
 //
 // For each item, a log with scans, ego pose and ground truth is made once:
-//   scenario NAME: vtrack-sim-log --scenario NAME --out <work>/<item>/run.lcm --seed N
+//   scenario NAME: vtrack-sim-log --scenario NAME --out <work>/<item>/run.lcm --seed N; with
+//                  several seeds one item per seed (NAME_seedN) and a row of their CLEAR MOT
+//                  counts summed (NAME_seeds; HOTA the mean over the seeds): one simulated run
+//                  is one draw of the sensor noise, and the tracker's discrete decisions make
+//                  its scores jump from draw to draw
 //   KITTI DIR:     vtrack-kitti2lcm --kitti DIR --sequence S --out <work>/<item>/run.lcm [--poses F | --oxts F]
 //   KITTI boxes DIR, each sequence S: vtrack-kitti2lcm --kitti DIR --sequence S (the boxes layout:
 //                  DETECTIONS, EGO_POSE, GROUND_TRUTH), tracked with --input-mode boxes; the
@@ -30,12 +34,15 @@ struct CompareItem {
   std::string source;    // [-] scenario NAME or path; KITTI directory
   std::string sequence;  // [-] kKitti, kKittiBoxes: its sequence (NNNN)
   std::string input_mode = "scans";  // [-] kKitti: vtrack-tracker --input-mode (scans | boxes | fused)
+  std::int64_t seed = 1;             // [-] kScenario: simulator seed
+  // [-] The summed row this item is part of ("" none): kitti_boxes_sum for the boxes sequences,
+  // NAME_seeds for a scenario run with several seeds.
+  std::string sum_row;
 };
 
 struct CompareOptions {
   std::vector<CompareItem> items;
   std::vector<std::string> modes = {"ism", "vasm", "mht"};
-  std::int64_t seed = 1;              // [-] simulator seed
   std::string json_path;              // [-] "" = no JSON
   std::string plots_dir;              // [-] "" = no plots
   std::string work_dir;               // [-] "" = a fresh temporary directory, removed at the end
@@ -55,6 +62,12 @@ struct CompareOptions {
 
 // Scenario item from a NAME or path ("urban_intersection", "config/scenarios/x.yaml").
 CompareItem ScenarioItem(const std::string& name_or_path);
+
+// The scenario's items for seeds (not empty): the item itself with that seed if there is one,
+// else one per seed named NAME_seedN, all in the summed row NAME_seeds. Throws
+// std::invalid_argument for a repeated seed.
+std::vector<CompareItem> ScenarioSeedItems(const CompareItem& scenario,
+                                           const std::vector<std::int64_t>& seeds);
 
 // The sequences of a boxes-layout folder: every DIR/label_02/NNNN.txt that has its
 // ego_pose_orbslam3/NNNN.txt, in order. Throws std::invalid_argument if there is none.

@@ -2,6 +2,7 @@
 // one table of the evaluator's metrics (see compare.h and log_tools/README.md).
 #include <boost/program_options.hpp>
 
+#include <cstdint>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -29,7 +30,8 @@ int main(int argc, char** argv) {
   CompareOptions o;
   std::string scenarios, modes = "ism,vasm,mht";
   std::vector<std::string> kitti_dirs;
-  std::string kitti_boxes_dir, sequences, kitti_input_modes = "scans";
+  std::string kitti_boxes_dir, sequences, kitti_input_modes = "scans", seeds;
+  std::int64_t seed = 1;
   bool no_dont_care = false;
 
   po::options_description desc(
@@ -64,7 +66,11 @@ int main(int argc, char** argv) {
      "count unmatched tracks in the labels' DontCare regions as false positives (by default "
      "they are not, as in the KITTI devkit)")
     ("modes", po::value(&modes)->default_value(modes), "tracker modes, comma separated")
-    ("seed", po::value(&o.seed)->default_value(o.seed), "simulator seed")
+    ("seed", po::value(&seed)->default_value(seed), "simulator seed")
+    ("seeds", po::value(&seeds),
+     "comma-separated simulator seeds (instead of --seed): each scenario run once per seed,\n"
+     "named <scenario>_seed<N>, and a row <scenario>_seeds of their CLEAR MOT counts summed\n"
+     "(MOTA from the sums) and their mean HOTA")
     ("json", po::value(&o.json_path), "write {scenario: {mode: summary}} here")
     ("plots", po::value(&o.plots_dir), "write <scenario>_modes.png (modes side by side) here")
     ("work-dir", po::value(&o.work_dir), "keep logs here (default: a temporary directory, removed)")
@@ -90,7 +96,27 @@ int main(int argc, char** argv) {
                                   "none)");
     }
     if (o.reuse && o.work_dir.empty()) throw std::invalid_argument("--reuse needs --work-dir");
-    for (const auto& s : SplitList(scenarios)) o.items.push_back(ScenarioItem(s));
+    if (!seeds.empty() && !vm["seed"].defaulted()) {
+      throw std::invalid_argument("--seed and --seeds: give one");
+    }
+    std::vector<std::int64_t> seed_list;
+    for (const auto& s : SplitList(seeds.empty() ? std::to_string(seed) : seeds)) {
+      std::size_t used = 0;
+      long long v = 0;
+      try {
+        v = std::stoll(s, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != s.size()) throw std::invalid_argument("--seeds: '" + s + "' is not an integer");
+      seed_list.push_back(v);
+    }
+    if (seed_list.empty()) throw std::invalid_argument("--seeds is empty");
+    for (const auto& s : SplitList(scenarios)) {
+      for (const CompareItem& item : ScenarioSeedItems(ScenarioItem(s), seed_list)) {
+        o.items.push_back(item);
+      }
+    }
     const std::vector<std::string> input_modes = SplitList(kitti_input_modes);
     if (input_modes.empty()) throw std::invalid_argument("--kitti-input-modes is empty");
     for (const auto& m : input_modes) {
@@ -132,6 +158,7 @@ int main(int argc, char** argv) {
           throw std::invalid_argument(std::string("--sequences: ") + e.what());
         }
         item.name = "kitti_boxes_" + item.sequence;
+        item.sum_row = "kitti_boxes_sum";
         o.items.push_back(item);
       }
     }

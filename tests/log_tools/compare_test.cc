@@ -208,6 +208,58 @@ TEST_F(CompareTest, AFailedModeIsReportedAndTheRestStillScored) {
   EXPECT_TRUE(j["fail_sim"]["mht"].IsNull());
 }
 
+// --seeds: each scenario once per seed (its own item and work directory), then a row of the
+// seeds' CLEAR MOT counts summed and their mean HOTA, after the scenario's last seed.
+TEST_F(CompareTest, SeveralSeedsGiveOneItemEachAndTheirSum) {
+  const std::string json = dir_ + "/cmp.json", calls = dir_ + "/calls.txt";
+  std::string out;
+  ASSERT_EQ(RunTool({"--scenarios", "alpha,beta", "--seeds", "3,5", "--modes", "ism,mht",
+                     "--bin-dir", fake_bin_, "--json", json},
+                    &out, {"FAKE_TOOL_LOG=" + calls}), 0) << out;
+  const std::string c = ReadFile(calls);
+  for (const char* call : {"vtrack-sim-log --scenario alpha --out run.lcm --seed 3",
+                           "vtrack-sim-log --scenario alpha --out run.lcm --seed 5",
+                           "vtrack-sim-log --scenario beta --out run.lcm --seed 5"}) {
+    EXPECT_NE(c.find(call), std::string::npos) << call << "\n" << c;
+  }
+  // The table (after the progress lines): alpha's seeds, then their sum, then beta's.
+  const std::size_t table = out.find("-----");
+  ASSERT_NE(table, std::string::npos) << out;
+  const std::size_t a3 = out.find("alpha_seed3", table), a5 = out.find("alpha_seed5", table),
+                    as = out.find("alpha_seeds", table), b3 = out.find("beta_seed3", table);
+  ASSERT_NE(as, std::string::npos) << out;
+  EXPECT_LT(a3, a5);
+  EXPECT_LT(a5, as);
+  EXPECT_LT(as, b3);
+  const YAML::Node j = YAML::LoadFile(json);
+  for (const char* mode : {"ism", "mht"}) {
+    const YAML::Node s3 = j["alpha_seed3"][mode], s5 = j["alpha_seed5"][mode], sum = j["alpha_seeds"][mode];
+    ASSERT_TRUE(s3.IsMap() && s5.IsMap() && sum.IsMap()) << mode;
+    for (const char* key : {"gt_detections", "true_positives", "false_positives", "false_negatives",
+                            "id_switches"}) {
+      EXPECT_EQ(sum[key].as<int>(), s3[key].as<int>() + s5[key].as<int>()) << key;
+    }
+    const double gt = sum["gt_detections"].as<double>();
+    ASSERT_GT(gt, 0.0);
+    EXPECT_NEAR(sum["mota"].as<double>(),
+                1.0 - (sum["false_negatives"].as<double>() + sum["false_positives"].as<double>() +
+                       sum["id_switches"].as<double>()) / gt, 1e-12);
+    EXPECT_NEAR(sum["hota"].as<double>(), 0.5 * (s3["hota"].as<double>() + s5["hota"].as<double>()), 1e-12);
+  }
+  EXPECT_TRUE(j["beta_seeds"]["mht"].IsMap());
+  EXPECT_FALSE(j["alpha"].IsDefined());
+  // One seed keeps the scenario's own name; a seed given twice, or both options, is refused.
+  EXPECT_EQ(RunTool({"--scenarios", "alpha", "--seeds", "4", "--modes", "mht", "--bin-dir", fake_bin_,
+                     "--json", json}, &out), 0) << out;
+  EXPECT_TRUE(YAML::LoadFile(json)["alpha"]["mht"].IsMap());
+  EXPECT_EQ(RunTool({"--scenarios", "alpha", "--seeds", "4,4"}, &out), 2);
+  EXPECT_NE(out.find("seed 4 given twice"), std::string::npos) << out;
+  EXPECT_EQ(RunTool({"--scenarios", "alpha", "--seeds", "4,5", "--seed", "2"}, &out), 2);
+  EXPECT_NE(out.find("--seed and --seeds"), std::string::npos) << out;
+  EXPECT_EQ(RunTool({"--scenarios", "alpha", "--seeds", "4,z"}, &out), 2);
+  EXPECT_NE(out.find("'z' is not an integer"), std::string::npos) << out;
+}
+
 TEST(CompareRealToolsTest, PaperScenarioThroughTheRealSimulatorAndTracker) {
   const std::string bin = BinDir();
   for (const char* tool : {"vtrack-compare", "vtrack-sim-log", "vtrack-tracker"}) {

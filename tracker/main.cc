@@ -202,6 +202,9 @@ int main(int argc, char** argv) {
       ("first-track-id", po::value(&first_track_id),
        "id of the first track (>= 1); default: live, from the start time (start ms x 100000 + 1,\n"
        "so that a restarted tracker never reuses an id), offline 1 (reruns identical)")
+      ("seed", po::value(&options.seed)->default_value(options.seed),
+       "seed of the fits' random draws (RANSAC): runs with one seed are identical, another seed\n"
+       "is another draw of the same data")
       ("lcm-url", po::value(&url)->default_value(""),
        "LCM URL for live mode ('' = $LCM_DEFAULT_URL or LCM's default); recv_buf_size=4194304 "
        "is appended to udpm:// URLs that lack it")

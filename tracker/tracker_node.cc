@@ -19,6 +19,7 @@ TrackerNode::TrackerNode(const TrackerParams& params, NodeOptions options, Publi
       publish_(std::move(publish)),
       tracker_(params, options_.debug) {
   tracker_.SetFirstTrackId(options_.first_track_id);
+  tracker_.SetSeed(options_.seed);
   if (!options_.evidence_csv.empty()) {
     evidence_csv_.open(options_.evidence_csv);
     if (!evidence_csv_) {

@@ -39,6 +39,8 @@ struct NodeOptions {
   // The first track id. Offline: 1 (reruns identical). Live: FirstTrackIdAt(wall clock), so
   // that a restarted tracker never reuses an id that meant another vehicle before.
   std::int64_t first_track_id = 1;
+  // The seed of the fits' random draws (Tracker::SetSeed).
+  std::int64_t seed = 1;
 };
 
 class TrackerNode {

@@ -262,16 +262,15 @@ CompareItem ScenarioItem(const std::string& name_or_path) {
   return item;
 }
 
-std::vector<CompareItem> ScenarioSeedItems(const CompareItem& scenario,
-                                           const std::vector<std::int64_t>& seeds) {
+std::vector<CompareItem> SeedItems(const CompareItem& base, const std::vector<std::int64_t>& seeds) {
   if (seeds.empty()) throw std::invalid_argument("no seed");
   std::vector<CompareItem> out;
   for (const std::int64_t seed : seeds) {
-    CompareItem item = scenario;
+    CompareItem item = base;
     item.seed = seed;
     if (seeds.size() > 1) {
-      item.name = scenario.name + "_seed" + std::to_string(seed);
-      item.sum_row = scenario.name + "_seeds";
+      item.name = base.name + "_seed" + std::to_string(seed);
+      item.sum_row = base.name + "_seeds";
     }
     for (const CompareItem& other : out) {
       if (other.seed == seed) {
@@ -433,6 +432,7 @@ int RunCompare(const CompareOptions& o) {
             argv.insert(argv.end(), {"--input-mode", item.input_mode});
           }
           if (!o.tracker_config.empty()) argv.insert(argv.end(), {"--config", o.tracker_config});
+          if (item.seed != 1) argv.insert(argv.end(), {"--seed", std::to_string(item.seed)});
           say(item.name + " / " + mode + ": " + Join(argv));
           const auto t = std::chrono::steady_clock::now();
           RunProcess(argv, (dir / ("tracker_" + mode + ".log")).string(), o.timeout_s);
@@ -493,14 +493,14 @@ int RunCompare(const CompareOptions& o) {
     sum_rows.push_back(item.sum_row);
     for (const std::string& mode : o.modes) {
       std::vector<const EvalSummary*> parts;
-      bool scenarios = true;
+      bool draws = true;  // runs of one item with several seeds (not the boxes sequences)
       for (const CompareItem& part : o.items) {
         if (part.sum_row != item.sum_row) continue;
-        scenarios = scenarios && part.kind == CompareItem::Kind::kScenario;
+        draws = draws && part.kind != CompareItem::Kind::kKittiBoxes;
         const auto it = results.find(part.name);
         if (it != results.end() && it->second.count(mode)) parts.push_back(&it->second.at(mode));
       }
-      if (!parts.empty()) sums[item.sum_row][mode] = SumOf(parts, scenarios);
+      if (!parts.empty()) sums[item.sum_row][mode] = SumOf(parts, draws);
       const auto& row_sums = sums[item.sum_row];
       rows.push_back({item.sum_row, mode, row_sums.count(mode) ? &row_sums.at(mode) : nullptr});
     }

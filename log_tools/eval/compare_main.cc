@@ -66,11 +66,13 @@ int main(int argc, char** argv) {
      "count unmatched tracks in the labels' DontCare regions as false positives (by default "
      "they are not, as in the KITTI devkit)")
     ("modes", po::value(&modes)->default_value(modes), "tracker modes, comma separated")
-    ("seed", po::value(&seed)->default_value(seed), "simulator seed")
+    ("seed", po::value(&seed)->default_value(seed),
+     "simulator seed, also the tracker's (its fits' random draws; passed unless 1)")
     ("seeds", po::value(&seeds),
-     "comma-separated simulator seeds (instead of --seed): each scenario run once per seed,\n"
-     "named <scenario>_seed<N>, and a row <scenario>_seeds of their CLEAR MOT counts summed\n"
-     "(MOTA from the sums) and their mean HOTA")
+     "comma-separated seeds (instead of --seed): each scenario, and each KITTI item measured by\n"
+     "scans, run once per seed (the simulator's and the tracker's --seed), named <item>_seed<N>,\n"
+     "then a row <item>_seeds of their CLEAR MOT counts summed (MOTA from the sums) and their\n"
+     "mean HOTA")
     ("json", po::value(&o.json_path), "write {scenario: {mode: summary}} here")
     ("plots", po::value(&o.plots_dir), "write <scenario>_modes.png (modes side by side) here")
     ("work-dir", po::value(&o.work_dir), "keep logs here (default: a temporary directory, removed)")
@@ -113,7 +115,7 @@ int main(int argc, char** argv) {
     }
     if (seed_list.empty()) throw std::invalid_argument("--seeds is empty");
     for (const auto& s : SplitList(scenarios)) {
-      for (const CompareItem& item : ScenarioSeedItems(ScenarioItem(s), seed_list)) {
+      for (const CompareItem& item : SeedItems(ScenarioItem(s), seed_list)) {
         o.items.push_back(item);
       }
     }
@@ -139,7 +141,10 @@ int main(int argc, char** argv) {
         item.sequence = seq;
         item.input_mode = m;
         item.name = "kitti_" + seq + (m == "scans" ? "" : "_" + m);
-        o.items.push_back(item);
+        // Boxes alone draw nothing at random: one run.
+        const std::vector<std::int64_t> runs =
+            m == "boxes" ? std::vector<std::int64_t>{seed_list.front()} : seed_list;
+        for (const CompareItem& run : SeedItems(item, runs)) o.items.push_back(run);
       }
     }
     if (!sequences.empty() && kitti_boxes_dir.empty()) {

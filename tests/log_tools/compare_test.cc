@@ -208,18 +208,30 @@ TEST_F(CompareTest, AFailedModeIsReportedAndTheRestStillScored) {
   EXPECT_TRUE(j["fail_sim"]["mht"].IsNull());
 }
 
-// --seeds: each scenario once per seed (its own item and work directory), then a row of the
-// seeds' CLEAR MOT counts summed and their mean HOTA, after the scenario's last seed.
+// --seeds: each scenario and each KITTI item measured by scans once per seed (its own item and
+// work directory; the simulator's and the tracker's seed), then a row of the seeds' CLEAR MOT
+// counts summed and their mean HOTA, after the item's last seed. Boxes alone: one run.
 TEST_F(CompareTest, SeveralSeedsGiveOneItemEachAndTheirSum) {
+  const std::string kitti = dir_ + "/kitti";
+  fs::create_directories(kitti + "/calib");
+  {
+    std::ofstream c(kitti + "/calib/0000.txt");
+    const char* p = "500 0 600 0 0 500 180 0 0 0 1 0";
+    c << "P0: " << p << "\nP1: " << p << "\nP2: " << p << "\nP3: " << p << "\n"
+      << "R0_rect: 1 0 0 0 1 0 0 0 1\nTr_velo_to_cam: 0 -1 0 0 0 0 -1 0 1 0 0 0\n";
+  }
   const std::string json = dir_ + "/cmp.json", calls = dir_ + "/calls.txt";
   std::string out;
-  ASSERT_EQ(RunTool({"--scenarios", "alpha,beta", "--seeds", "3,5", "--modes", "ism,mht",
-                     "--bin-dir", fake_bin_, "--json", json},
+  ASSERT_EQ(RunTool({"--scenarios", "alpha,beta", "--kitti", kitti, "--kitti-input-modes",
+                     "scans,boxes", "--seeds", "3,5", "--modes", "ism,mht", "--bin-dir", fake_bin_,
+                     "--json", json},
                     &out, {"FAKE_TOOL_LOG=" + calls}), 0) << out;
   const std::string c = ReadFile(calls);
   for (const char* call : {"vtrack-sim-log --scenario alpha --out run.lcm --seed 3",
                            "vtrack-sim-log --scenario alpha --out run.lcm --seed 5",
-                           "vtrack-sim-log --scenario beta --out run.lcm --seed 5"}) {
+                           "vtrack-sim-log --scenario beta --out run.lcm --seed 5",
+                           "vtrack-tracker --input run.lcm --output tracks_mht.lcm --mode mht --seed 5",
+                           "--input-mode scans --seed 3"}) {
     EXPECT_NE(c.find(call), std::string::npos) << call << "\n" << c;
   }
   // The table (after the progress lines): alpha's seeds, then their sum, then beta's.
@@ -248,6 +260,10 @@ TEST_F(CompareTest, SeveralSeedsGiveOneItemEachAndTheirSum) {
   }
   EXPECT_TRUE(j["beta_seeds"]["mht"].IsMap());
   EXPECT_FALSE(j["alpha"].IsDefined());
+  for (const char* item : {"kitti_0000_seed3", "kitti_0000_seed5", "kitti_0000_seeds", "kitti_0000_boxes"}) {
+    EXPECT_TRUE(j[item]["mht"].IsMap()) << item;
+  }
+  EXPECT_FALSE(j["kitti_0000_boxes_seed5"].IsDefined());
   // One seed keeps the scenario's own name; a seed given twice, or both options, is refused.
   EXPECT_EQ(RunTool({"--scenarios", "alpha", "--seeds", "4", "--modes", "mht", "--bin-dir", fake_bin_,
                      "--json", json}, &out), 0) << out;

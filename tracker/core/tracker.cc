@@ -15,11 +15,13 @@ namespace {
 
 std::string Str(std::int64_t v) { return std::to_string(v); }
 
-// The seed of the RANSAC fits of one track (salt: its id; a new object: -1 - its index): a
-// function of the scan and the track only, so that reruns are identical.
-std::uint64_t RansacSeed(std::int64_t scan_utime, std::int64_t salt) {
+// The seed of the RANSAC fits of one track (salt: its id; a new object: -1 - its index) in the
+// run of seed `run_seed` (Tracker::SetSeed): a function of the scan, the track and the run's seed
+// only, so that reruns are identical; run seed 1 (the default) adds nothing.
+std::uint64_t RansacSeed(std::int64_t run_seed, std::int64_t scan_utime, std::int64_t salt) {
   return static_cast<std::uint64_t>(scan_utime) * 0x9E3779B97F4A7C15ull ^
-         static_cast<std::uint64_t>(salt) * 0xC2B2AE3D27D4EB4Full;
+         static_cast<std::uint64_t>(salt) * 0xC2B2AE3D27D4EB4Full ^
+         static_cast<std::uint64_t>(run_seed - 1) * 0x165667B19E3779F9ull;
 }
 
 // The longest any track may coast: beyond, a jump forward in time resets the tracker.
@@ -294,7 +296,7 @@ void Tracker::UpdateTrack(std::size_t j, const LadarScan& scan, const Eigen::Vec
     manager_->Miss(j);
     return;
   }
-  manager_->Update(j, w->point_set, sensor_xy, RansacSeed(scan.utime, manager_->tracks()[j].id),
+  manager_->Update(j, w->point_set, sensor_xy, RansacSeed(seed_, scan.utime, manager_->tracks()[j].id),
                    debug_ ? &out->debug : nullptr, multi_ring ? &profile_ : nullptr, &w->measurer);
   out->has_debug = debug_;
   out->has_evidence = ObserveEvidence(j, idx, sensor_xy, multi_ring, w, &out->evidence);
@@ -340,7 +342,7 @@ void Tracker::CreateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_
     Worker& w = workers_.front();
     w.outline.Extract(points_, idx, scan, sensor_xy, &w.point_set);
     if (w.point_set.size() == 0) continue;
-    if (manager_->Create(w.point_set, sensor_xy, RansacSeed(scan.utime, -1 - static_cast<std::int64_t>(k)))) {
+    if (manager_->Create(w.point_set, sensor_xy, RansacSeed(seed_, scan.utime, -1 - static_cast<std::int64_t>(k)))) {
       const std::size_t index = manager_->tracks().size() - 1;
       created_.Add(manager_->Box(index));
       ScanOutput::EvidenceRow row;

@@ -96,6 +96,10 @@ class Tracker {
   // The id of the next track (see TrackManager::SetNextId). Throws std::invalid_argument if < 1.
   void SetFirstTrackId(std::int64_t id);
 
+  // The seed of the fits' random draws (RANSAC), default 1. Runs with one seed are identical;
+  // another seed is another draw of the same data (vtrack-compare --seeds on a real log).
+  void SetSeed(std::int64_t seed) { seed_ = seed; }
+
   const TrackManager& manager() const { return *manager_; }
   const TrackerParams& params() const { return params_; }
 
@@ -172,6 +176,7 @@ class Tracker {
   // recording) are a track's ends looked up in the profile. Set once from the parameters.
   bool hidden_ends_used_[2] = {false, false};
   std::int64_t returns_processed_ = 0;
+  std::int64_t seed_ = 1;  // SetSeed
 };
 
 }  // namespace vtrack

@@ -14,6 +14,9 @@
 #                      [paper_fig4_turn,paper_fig5_follow_clutter,paper_fig6_noisy_follow,urban_intersection]
 #   --modes LIST       tracker modes [ism,vasm,mht]
 #   --seed N           simulator seed [1]
+#   --draws LIST       seeds of the spread table [1,2,3,4,5]: every scene and KITTI 0000 (scans)
+#                      once per seed (vtrack-compare --seeds: the simulator's noise and the fits'
+#                      random draws), their counts pooled; "" leaves the table out
 #   --data DIR         real data [../shared/data]: kitti_tracking_0000 (scans) and
 #                      kitti_tracking_boxes (detector boxes) are used when present
 #   --no-kitti         leave the real data out
@@ -42,6 +45,7 @@ out=$here/docs/results.md
 scenarios=paper_fig4_turn,paper_fig5_follow_clutter,paper_fig6_noisy_follow,urban_intersection
 modes=ism,vasm,mht
 seed=1
+draws=1,2,3,4,5
 data=$here/../shared/data
 use_kitti=1
 bench=0
@@ -55,6 +59,7 @@ while [ $# -gt 0 ]; do
     --scenarios) [ $# -ge 2 ] || die "--scenarios needs a list" 2; scenarios=$2; shift 2 ;;
     --modes) [ $# -ge 2 ] || die "--modes needs a list" 2; modes=$2; shift 2 ;;
     --seed) [ $# -ge 2 ] || die "--seed needs a number" 2; seed=$2; shift 2 ;;
+    --draws) [ $# -ge 2 ] || die "--draws needs a list (or '')" 2; draws=$2; shift 2 ;;
     --data) [ $# -ge 2 ] || die "--data needs a directory" 2; data=$2; shift 2 ;;
     --no-kitti) use_kitti=0; shift ;;
     --bench) bench=1; shift ;;
@@ -65,6 +70,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 [[ $seed =~ ^[0-9]+$ ]] || die "--seed '$seed' is not a number" 2
+[ -z "$draws" ] || [[ $draws =~ ^[0-9]+(,[0-9]+)+$ ]] || die "--draws '$draws' is not a list of two or more numbers" 2
 [ "$bench" = 0 ] || [ -z "$bench_json" ] || die "--bench and --bench-json exclude each other" 2
 [ -z "$bench_json" ] || [ -s "$bench_json" ] || die "--bench-json: no file '$bench_json'" 2
 command -v jq >/dev/null || die "jq is needed (apt-get install jq)" 2
@@ -124,6 +130,19 @@ say "vtrack-compare on $what in modes $modes (the longest step)"
     --work-dir "$work/runs" --keep-work ) >"$work/compare.txt" \
   || die "vtrack-compare failed (its output above; logs in $work/runs)"
 compare_cmd="$B/bin/vtrack-compare ${compare_args[*]} --json WORK/compare.json --work-dir WORK/runs"
+
+# ---- 1b. the same, once per seed: how far one run's figures move from draw to draw -------------
+draws_cmd=
+if [ -n "$draws" ]; then
+  draws_args=(--scenarios "$scenarios" --modes "$modes" --seeds "$draws")
+  if [ "$use_kitti" = 1 ] && [ -d "$kitti_dir" ]; then draws_args+=(--kitti "$(rel "$kitti_dir")"); fi
+  say "vtrack-compare once per seed $draws (the spread table)"
+  ( cd "$here" && "$build/bin/vtrack-compare" "${draws_args[@]}" --json "$work/draws.json" \
+      --work-dir "$work/draws" ) >"$work/draws.txt" \
+    || die "vtrack-compare --seeds failed (its output in $work/draws.txt)"
+  rm -rf "$work/draws"  # several GB of logs
+  draws_cmd="$B/bin/vtrack-compare ${draws_args[*]} --json WORK/draws.json"
+fi
 
 # ---- 2. per-vehicle scores of the same logs -------------------------------------------------------
 scores_md=
@@ -209,6 +228,22 @@ iou_table() {
       ([$root.kitti_boxes_sum | to_entries[] | select(.value != null) | "\(.key) \(.value.prediction_samples."1") / \(.value.prediction_turning."1".samples) / \(.value.prediction_straight."1".samples)"] | join("; "))' "$1"
 }
 
+# The pooled rows (<item>_seeds) of a vtrack-compare --seeds JSON, with each draw's MOTA.
+draws_table() {
+  jq -r '
+    def f($x; $d): if $x == null then "-" else ($x * pow(10; $d) | round / pow(10; $d) | tostring) end;
+    . as $root |
+    "| item | mode | MOTA pooled | MOTA per seed | HOTA mean | IDSW (sum) | FP / FN (sum) |",
+    "| --- | --- | --- | --- | --- | --- | --- |",
+    (to_entries[] | select(.key | endswith("_seeds")) | (.key | sub("_seeds$"; "")) as $item | .value | to_entries[] |
+      .key as $mode | .value as $s |
+      ([$root | to_entries[] | select(.key | startswith($item + "_seed")) | select(.key | endswith("_seeds") | not) |
+        .value[$mode] | if . == null then "failed" else f(.mota; 3) end] | join(" / ")) as $per |
+      if $s == null then "| \($item) | \($mode) | failed | \($per) | | | |"
+      else "| \($item) | \($mode) | \(f($s.mota; 3)) | \($per) | \(f($s.hota; 3)) | \($s.id_switches) | \($s.false_positives) / \($s.false_negatives) |"
+      end)' "$1"
+}
+
 bench_table() {
   jq -r '
     def f($x; $d): if $x == null then "n/a" else ($x * pow(10; $d) | round / pow(10; $d) | tostring) end;
@@ -264,6 +299,25 @@ $compare_cmd
 
 $(compare_table "$work/compare.json")
 EOF
+  if [ -n "$draws_cmd" ]; then
+    cat <<EOF
+
+## Spread from draw to draw
+
+One run is one draw: of the simulator's sensor noise and, in every item, of the fits' random
+draws (RANSAC; \`vtrack-tracker --seed\`). The tracker's decisions are discrete (a track
+confirmed, split, classed or deleted a scan earlier or later), so a scene's figures move from
+draw to draw by more than most changes of the tracker move them: compare changes on the pooled
+rows. Each item once per seed $draws; MOTA pooled from the CLEAR MOT counts summed over the
+seeds, HOTA the mean of the seeds' values.
+
+\`\`\`sh
+$draws_cmd
+\`\`\`
+
+$(draws_table "$work/draws.json")
+EOF
+  fi
   if [ -n "$scores_md" ]; then
     cat <<EOF
 

@@ -23,6 +23,15 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A KITTI calibration for sequence seq in dir/calib: camera 2 looking along velo x, +-50 deg.
+void WriteCalib(const std::string& dir, const std::string& seq) {
+  fs::create_directories(dir + "/calib");
+  std::ofstream c(dir + "/calib/" + seq + ".txt");
+  const char* p = "500 0 600 0 0 500 180 0 0 0 1 0";
+  c << "P0: " << p << "\nP1: " << p << "\nP2: " << p << "\nP3: " << p << "\n"
+    << "R0_rect: 1 0 0 0 1 0 0 0 1\nTr_velo_to_cam: 0 -1 0 0 0 0 -1 0 1 0 0 0\n";
+}
+
 class CompareTest : public ToolTest {
  protected:
   CompareTest() : ToolTest("vtrack-compare", "compare") {}
@@ -56,15 +65,9 @@ TEST_F(CompareTest, HelpAndBadOptions) {
 }
 
 TEST_F(CompareTest, ThreeModesOnTwoScenariosAndKitti) {
-  // A KITTI folder with a calibration (camera 2 looking along velo x, +-50 deg).
+  // A KITTI folder with a calibration.
   const std::string kitti = dir_ + "/kitti";
-  fs::create_directories(kitti + "/calib");
-  {
-    std::ofstream c(kitti + "/calib/0000.txt");
-    const char* p = "500 0 600 0 0 500 180 0 0 0 1 0";
-    c << "P0: " << p << "\nP1: " << p << "\nP2: " << p << "\nP3: " << p << "\n"
-      << "R0_rect: 1 0 0 0 1 0 0 0 1\nTr_velo_to_cam: 0 -1 0 0 0 0 -1 0 1 0 0 0\n";
-  }
+  WriteCalib(kitti, "0000");
   const std::string json = dir_ + "/cmp.json", plots = dir_ + "/plots", calls = dir_ + "/calls.txt";
   std::string out;
   ASSERT_EQ(RunTool({"--scenarios", "alpha,config/beta.yaml", "--kitti", kitti, "--bin-dir", fake_bin_,
@@ -116,13 +119,7 @@ TEST_F(CompareTest, ThreeModesOnTwoScenariosAndKitti) {
 // labels then share the frame's time: no half-sweep offset), the fused one tracked with both.
 TEST_F(CompareTest, KittiInputModesGiveOneItemEach) {
   const std::string kitti = dir_ + "/kitti_modes";
-  fs::create_directories(kitti + "/calib");
-  {
-    std::ofstream c(kitti + "/calib/0000.txt");
-    const char* p = "500 0 600 0 0 500 180 0 0 0 1 0";
-    c << "P0: " << p << "\nP1: " << p << "\nP2: " << p << "\nP3: " << p << "\n"
-      << "R0_rect: 1 0 0 0 1 0 0 0 1\nTr_velo_to_cam: 0 -1 0 0 0 0 -1 0 1 0 0 0\n";
-  }
+  WriteCalib(kitti, "0000");
   const std::string json = dir_ + "/modes.json", calls = dir_ + "/modes_calls.txt";
   std::string out;
   EXPECT_EQ(RunTool({"--kitti", kitti, "--kitti-input-modes", "scans,lidar", "--bin-dir", fake_bin_},
@@ -163,14 +160,8 @@ TEST_F(CompareTest, KittiInputModesGiveOneItemEach) {
 // sequences needs --kitti-sequence.
 TEST_F(CompareTest, AKittiFolderOfAnotherSequenceIsScoredUnderItsOwnNumber) {
   const std::string kitti = dir_ + "/kitti_0007";
-  fs::create_directories(kitti + "/calib");
+  WriteCalib(kitti, "0007");
   fs::create_directories(kitti + "/label_02");
-  {
-    std::ofstream c(kitti + "/calib/0007.txt");
-    const char* p = "500 0 600 0 0 500 180 0 0 0 1 0";
-    c << "P0: " << p << "\nP1: " << p << "\nP2: " << p << "\nP3: " << p << "\n"
-      << "R0_rect: 1 0 0 0 1 0 0 0 1\nTr_velo_to_cam: 0 -1 0 0 0 0 -1 0 1 0 0 0\n";
-  }
   std::ofstream(kitti + "/label_02/0007.txt")
       << "0 -1 DontCare -1 -1 -10 100 100 200 200 -1 -1 -1 -1000 -1000 -1000 -10\n";
   const std::string json = dir_ + "/seq7.json", calls = dir_ + "/seq7_calls.txt";
@@ -213,13 +204,7 @@ TEST_F(CompareTest, AFailedModeIsReportedAndTheRestStillScored) {
 // counts summed and their mean HOTA, after the item's last seed. Boxes alone: one run.
 TEST_F(CompareTest, SeveralSeedsGiveOneItemEachAndTheirSum) {
   const std::string kitti = dir_ + "/kitti";
-  fs::create_directories(kitti + "/calib");
-  {
-    std::ofstream c(kitti + "/calib/0000.txt");
-    const char* p = "500 0 600 0 0 500 180 0 0 0 1 0";
-    c << "P0: " << p << "\nP1: " << p << "\nP2: " << p << "\nP3: " << p << "\n"
-      << "R0_rect: 1 0 0 0 1 0 0 0 1\nTr_velo_to_cam: 0 -1 0 0 0 0 -1 0 1 0 0 0\n";
-  }
+  WriteCalib(kitti, "0000");
   const std::string json = dir_ + "/cmp.json", calls = dir_ + "/calls.txt";
   std::string out;
   ASSERT_EQ(RunTool({"--scenarios", "alpha,beta", "--kitti", kitti, "--kitti-input-modes",

@@ -13,10 +13,10 @@
 #   --scenarios LIST   simulated scenes, comma separated
 #                      [paper_fig4_turn,paper_fig5_follow_clutter,paper_fig6_noisy_follow,urban_intersection]
 #   --modes LIST       tracker modes [ism,vasm,mht]
-#   --seed N           simulator seed [1]
-#   --draws LIST       seeds of the spread table [1,2,3,4,5]: every scene and KITTI 0000 (scans)
-#                      once per seed (vtrack-compare --seeds: the simulator's noise and the fits'
-#                      random draws), their counts pooled; "" leaves the table out
+#   --seed N           seed of the simulator and the tracker's random draws [1]
+#   --draws LIST       two or more seeds for the spread table [1,2,3,4,5]: every scene and KITTI
+#                      0000 (scans) once per seed (vtrack-compare --seeds: the simulator's noise and
+#                      the fits' random draws), their counts pooled; "" leaves the table out
 #   --data DIR         real data [../shared/data]: kitti_tracking_0000 (scans) and
 #                      kitti_tracking_boxes (detector boxes) are used when present
 #   --no-kitti         leave the real data out
@@ -237,7 +237,7 @@ draws_table() {
     "| --- | --- | --- | --- | --- | --- | --- |",
     (to_entries[] | select(.key | endswith("_seeds")) | (.key | sub("_seeds$"; "")) as $item | .value | to_entries[] |
       .key as $mode | .value as $s |
-      ([$root | to_entries[] | select(.key | startswith($item + "_seed")) | select(.key | endswith("_seeds") | not) |
+      ([$root | to_entries[] | select(.key | test("^" + $item + "_seed[0-9]+$")) |
         .value[$mode] | if . == null then "failed" else f(.mota; 3) end] | join(" / ")) as $per |
       if $s == null then "| \($item) | \($mode) | failed | \($per) | | | |"
       else "| \($item) | \($mode) | \(f($s.mota; 3)) | \($per) | \(f($s.hota; 3)) | \($s.id_switches) | \($s.false_positives) / \($s.false_negatives) |"
@@ -291,7 +291,7 @@ WORK below is the script's work directory (\`--work-dir\`). What each metric mea
 
 \`vtrack-eval\` scoring: confirmed tracks classed vehicle, CLEAR MOT gate 2 m, all ranges; KITTI:
 cars and vans within 40 m in camera 2's view, unmatched tracks in DontCare regions not counted
-(as the KITTI devkit; log_tools/README.md). Simulator seed $seed.
+(as the KITTI devkit; log_tools/README.md). Seed $seed (the simulator's and the tracker's).
 
 \`\`\`sh
 $compare_cmd

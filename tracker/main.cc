@@ -249,6 +249,10 @@ int main(int argc, char** argv) {
     std::cerr << "vtrack-tracker: --input and --output go together\n";
     return 2;
   }
+  if (options.seed < 0) {
+    std::cerr << "vtrack-tracker: --seed " << options.seed << " must be >= 0\n";
+    return 2;
+  }
   if (vm.count("first-track-id")) {
     if (first_track_id < 1) {
       std::cerr << "vtrack-tracker: --first-track-id " << first_track_id << " must be >= 1\n";

@@ -162,8 +162,8 @@ void PoolMeans(const std::vector<std::pair<const std::vector<double>*, const std
 
 // The CLEAR MOT counts of every sequence summed (MOTA recomputed from them, MOTP weighted by
 // the matches), and the prediction errors (all, turning, straight) weighted by their samples;
-// mean_hota: HOTA and its parts the mean over the parts (runs of one scenario), else NaN (the
-// boxes sequences: their sum is not a HOTA); the rest is not summed.
+// mean_hota: HOTA and its parts the mean over the parts (runs of one item with several seeds),
+// else NaN (the boxes sequences: their sum is not a HOTA); the rest is not summed.
 EvalSummary SumOf(const std::vector<const EvalSummary*>& parts, bool mean_hota) {
   EvalSummary s;
   double motp_sum = 0.0;
@@ -492,15 +492,18 @@ int RunCompare(const CompareOptions& o) {
     if (!last) continue;
     sum_rows.push_back(item.sum_row);
     for (const std::string& mode : o.modes) {
+      // Every part or none: a sum over the runs that happened to succeed would read as the whole.
       std::vector<const EvalSummary*> parts;
       bool draws = true;  // runs of one item with several seeds (not the boxes sequences)
+      bool complete = true;
       for (const CompareItem& part : o.items) {
         if (part.sum_row != item.sum_row) continue;
         draws = draws && part.kind != CompareItem::Kind::kKittiBoxes;
         const auto it = results.find(part.name);
         if (it != results.end() && it->second.count(mode)) parts.push_back(&it->second.at(mode));
+        else complete = false;
       }
-      if (!parts.empty()) sums[item.sum_row][mode] = SumOf(parts, draws);
+      if (complete && !parts.empty()) sums[item.sum_row][mode] = SumOf(parts, draws);
       const auto& row_sums = sums[item.sum_row];
       rows.push_back({item.sum_row, mode, row_sums.count(mode) ? &row_sums.at(mode) : nullptr});
     }

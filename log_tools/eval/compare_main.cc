@@ -98,19 +98,23 @@ int main(int argc, char** argv) {
                                   "none)");
     }
     if (o.reuse && o.work_dir.empty()) throw std::invalid_argument("--reuse needs --work-dir");
-    if (!seeds.empty() && !vm["seed"].defaulted()) {
+    if (vm.count("seeds") && !vm["seed"].defaulted()) {
       throw std::invalid_argument("--seed and --seeds: give one");
     }
+    if (seed < 0) throw std::invalid_argument("--seed " + std::to_string(seed) + " must be >= 0");
     std::vector<std::int64_t> seed_list;
-    for (const auto& s : SplitList(seeds.empty() ? std::to_string(seed) : seeds)) {
+    for (const auto& s : SplitList(vm.count("seeds") ? seeds : std::to_string(seed))) {
       std::size_t used = 0;
-      long long v = 0;
+      long long v = -1;
       try {
         v = std::stoll(s, &used);
+      } catch (const std::out_of_range&) {
+        throw std::invalid_argument("--seeds: '" + s + "' is out of range");
       } catch (const std::exception&) {
         used = 0;
       }
-      if (used != s.size()) throw std::invalid_argument("--seeds: '" + s + "' is not an integer");
+      if (used != s.size() || s.empty()) throw std::invalid_argument("--seeds: '" + s + "' is not an integer");
+      if (v < 0) throw std::invalid_argument("--seeds: " + s + " must be >= 0");
       seed_list.push_back(v);
     }
     if (seed_list.empty()) throw std::invalid_argument("--seeds is empty");

@@ -1,7 +1,8 @@
 // Stands in for vtrack-sim-log, vtrack-tracker and vtrack-kitti2lcm (chosen by the name it is
 // called by) in vtrack-compare's test, so that the orchestration is tested with known results:
 // the "simulator" and "converter" write the synthetic run, the "tracker" writes the synthetic
-// tracks with a centre offset per mode (ism 0.5 m, vasm 0.3 m, mht 0.1 m).
+// tracks with a centre offset per mode (ism 0.5 m, vasm 0.3 m, mht 0.1 m; 0.02 m more per --seed
+// above 1).
 // FAKE_TOOL_LOG: append each command line to this file. FAKE_TRACKER_FAIL_MODE: the tracker
 // fails (exit 4) for this mode.
 #include <cstdio>
@@ -43,7 +44,9 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "fake tracker: mode %s fails\n", mode.c_str());
       return 4;
     }
-    const double offset = mode == "ism" ? 0.5 : mode == "vasm" ? 0.3 : 0.1;
+    // --seed N (vtrack-compare passes it unless 1): 0.02 m more per seed above 1.
+    const double seed = opt.count("--seed") ? std::stod(opt["--seed"]) : 1.0;
+    const double offset = (mode == "ism" ? 0.5 : mode == "vasm" ? 0.3 : 0.1) + 0.02 * (seed - 1.0);
     vtrack::testing::WriteSyntheticTracks(opt["--output"], mode, offset);
     return 0;
   }

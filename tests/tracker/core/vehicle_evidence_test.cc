@@ -316,6 +316,19 @@ TEST(VehicleEvidence, TopRingIsTheHighestBeamWhicheverWayRingsAreNumbered) {
   EXPECT_EQ(TopRing(flat), -1);
 }
 
+// Six returns 0.5 m across at (10, 5) at t = 1 s: a new track of them is a small object.
+PointSet SmallObjectReturns() {
+  PointSet pts;
+  pts.origin = Eigen::Vector2d(10.0, 5.0);
+  for (int i = 0; i < 6; ++i) {
+    pts.x.push_back(0.1f * static_cast<float>(i));
+    pts.y.push_back(0.05f * static_cast<float>(i % 2));
+  }
+  pts.extent = std::hypot(0.5, 0.05);
+  pts.mean_utime = 1'000'000;
+  return pts;
+}
+
 // Through the track manager: scans whose evidence drops to p = 0.4 keep a vehicle reported as a
 // vehicle (keep_probability 0.3); at p = 0.2 it becomes other, and p = 0.4 does not bring it back.
 TEST(VehicleEvidence, TheManagerReportsAVehicleWhileItsEvidenceStaysAboveKeep) {
@@ -329,14 +342,7 @@ TEST(VehicleEvidence, TheManagerReportsAVehicleWhileItsEvidenceStaysAboveKeep) {
   p.evidence.keep_probability = 0.3;
   const Ekf ekf(p.ism, p.vasm, p.ekf, p.cv);
   TrackManager manager(p.manager, ekf, p.fit, p.shape);
-  PointSet pts;
-  pts.origin = Eigen::Vector2d(10.0, 5.0);
-  for (int i = 0; i < 6; ++i) {
-    pts.x.push_back(0.1f * static_cast<float>(i));
-    pts.y.push_back(0.05f * static_cast<float>(i % 2));
-  }
-  pts.extent = std::hypot(0.5, 0.05);
-  pts.mean_utime = 1'000'000;
+  const PointSet pts = SmallObjectReturns();
   manager.SetEvidence(p.evidence);
   ASSERT_TRUE(manager.Create(pts, Eigen::Vector2d::Zero(), 1));
   ReturnEvidence r;
@@ -379,14 +385,7 @@ TEST(VehicleEvidence, ATrackStartsAtThePriorOfTheModelThatFirstMeasuresIt) {
     const Ekf ekf(p.ism, p.vasm, p.ekf, p.cv);
     TrackManager manager(p.manager, ekf, p.fit, p.shape);
     manager.SetEvidence(p.evidence);
-    PointSet pts;
-    pts.origin = Eigen::Vector2d(10.0, 5.0);
-    for (int i = 0; i < 6; ++i) {
-      pts.x.push_back(0.1f * static_cast<float>(i));
-      pts.y.push_back(0.05f * static_cast<float>(i % 2));
-    }
-    pts.extent = std::hypot(0.5, 0.05);
-    pts.mean_utime = 1'000'000;
+    const PointSet pts = SmallObjectReturns();
     ASSERT_TRUE(manager.Create(pts, Eigen::Vector2d::Zero(), 1));
     ReturnEvidence r;
     r.three_d = three_d;
@@ -419,14 +418,7 @@ TEST(VehicleEvidence, ASmallObjectClassedVehicleIsReportedAtAVehiclesSize) {
   const Ekf ekf(p.ism, p.vasm, p.ekf, p.cv);
   TrackManager manager(p.manager, ekf, p.fit, p.shape);
   manager.SetEvidence(p.evidence);
-  PointSet pts;
-  pts.origin = Eigen::Vector2d(10.0, 5.0);
-  for (int i = 0; i < 6; ++i) {  // 0.5 m across
-    pts.x.push_back(0.1f * static_cast<float>(i));
-    pts.y.push_back(0.05f * static_cast<float>(i % 2));
-  }
-  pts.extent = std::hypot(0.5, 0.05);
-  pts.mean_utime = 1'000'000;
+  const PointSet pts = SmallObjectReturns();
   ASSERT_TRUE(manager.Create(pts, Eigen::Vector2d::Zero(), 1));
   ASSERT_TRUE(manager.tracks()[0].small_object);
   ReturnEvidence r;

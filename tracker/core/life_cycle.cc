@@ -18,7 +18,7 @@ bool AdvanceStatus(const Ekf& ekf, const TrackManagerParams& params, std::int64_
     if (t->consecutive_misses >= params.tentative_max_misses) keep = false;
     else if (t->num_updates >= params.confirm_updates) t->status = TrackStatus::kConfirmed;
   } else {
-    t->status = updated ? TrackStatus::kConfirmed : TrackStatus::kCoasting;
+    t->status = updated || t->seen_this_scan ? TrackStatus::kConfirmed : TrackStatus::kCoasting;
     // A parked object may stay hidden behind stopped traffic for longer than a moving one may
     // go unseen (max_position_std still applies to both).
     const double coast_max =

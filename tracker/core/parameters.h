@@ -471,7 +471,7 @@ struct TrackManagerParams {
     v("fail_misses", &fail_misses, {"-", AtLeast(1), "consecutive misses that fail a hypothesis"});
     v("confirm_updates", &confirm_updates, {"-", AtLeast(1), "updates that confirm a track"});
     v("tentative_max_misses", &tentative_max_misses, {"-", AtLeast(1), "consecutive misses that delete a tentative track"});
-    v("coast_max_s", &coast_max_s, {"s", Above(0), "a confirmed track coasts at most this long"});
+    v("coast_max_s", &coast_max_s, {"s", Above(0), "a confirmed track lives at most this long without an accepted update"});
     v("parked_coast_max_s", &parked_coast_max_s, {"s", Above(0), "... a parked one (no mover, slower than mover_min_speed) at most this long"});
     v("max_position_std", &max_position_std, {"m", Above(0), "tracks less certain than this are deleted"});
     v("duplicate_overlap", &duplicate_overlap, {"-", OpenClosed(0, 1), "overlap (of the smaller rectangle) that makes two tracks duplicates"});

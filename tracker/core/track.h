@@ -57,6 +57,7 @@ struct Track {
   std::int64_t last_update_utime = 0;     // [us]
   int num_updates = 0;
   int consecutive_misses = 0;             // [-] scans without any update
+  bool seen_this_scan = false;            // [-] this scan gave it returns (accepted or not)
   bool small_object = false;              // measured by centroid (poles, bushes, pedestrians)
   bool axis_from_full_face = false;       // heading set by a fully seen short face (AlignToFullFace)
   double full_face_extent = 0.0;          // [m] that face's extent (a car's front or rear width)

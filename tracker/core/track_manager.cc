@@ -104,6 +104,7 @@ void TrackManager::Update(std::size_t index, const PointSet& points,
                           TrackMeasurer* measurer) {
   if (measurer == nullptr) measurer = &measurer_;
   Track& t = tracks_[index];
+  t.seen_this_scan = true;
   const std::int64_t tm = std::max(points.mean_utime, t.state_utime);
   const double dt = static_cast<double>(tm - t.state_utime) * 1e-6;
   if (debug) debug->predicted = RectangleOf(t, PredictReported(ekf_, t, tm));
@@ -432,6 +433,7 @@ void TrackManager::EndScan(std::int64_t utime) {
   for (std::size_t i = 0; i < tracks_.size(); ++i) {
     Track& t = tracks_[i];
     if (!AdvanceStatus(ekf_, params_, utime, PredictReported(ekf_, t, utime), &t)) remove[i] = 1;
+    t.seen_this_scan = false;
   }
   std::vector<PredictedObject> boxes;
   Predict(utime, &boxes);

@@ -110,6 +110,56 @@ TEST(ParkedTrackTest, MissedParkedTrackIsLookedForWhereItWasWithoutGateGrowthAnd
   EXPECT_LE(static_cast<double>(t - last_update) * 1e-6, params.parked_coast_max_s + 0.15);
 }
 
+// Three returns on the car's rear face: too few for a fit (FitParams::min_points), so they give
+// the track no accepted update.
+PointSet TooFewToFit(std::int64_t utime) {
+  PointSet p;
+  p.origin = Eigen::Vector2d(20.0, 5.0);
+  for (double y : {4.6, 5.0, 5.4}) {
+    p.x.push_back(static_cast<float>(17.75 - 20.0));
+    p.y.push_back(static_cast<float>(y - 5.0));
+  }
+  p.mean_utime = utime;
+  p.extent = 0.8;
+  return p;
+}
+
+// The status says whether a scan saw the object, not whether it moved its state: a confirmed
+// track given returns that update none of its hypotheses stays confirmed (its object is there),
+// while the scans without an accepted update still count towards its deletion, as a hidden
+// one's do; a track given no returns coasts.
+TEST(ParkedTrackTest, ReturnsWithoutAnAcceptedUpdateKeepItConfirmedButDoNotKeepItAlive) {
+  Scans s;
+  SeeParkedCornerFor2s(&s);
+  TrackManager& m = s.m;
+  ASSERT_EQ(m.tracks().size(), 1u);
+  ASSERT_EQ(m.tracks()[0].status, TrackStatus::kConfirmed);
+  const std::int64_t last_update = s.t;
+  int scans = 0;
+  for (int k = 21; k <= 60 && !m.tracks().empty(); ++k) {
+    s.t += kStep;
+    s.Update(k, TooFewToFit(s.t));
+    if (m.tracks().empty()) break;
+    ++scans;
+    EXPECT_EQ(m.tracks()[0].consecutive_misses, scans) << "scan " << k << ": an update was accepted";
+    EXPECT_EQ(m.tracks()[0].last_update_utime, last_update);
+    EXPECT_EQ(m.tracks()[0].status, TrackStatus::kConfirmed) << "scan " << k;
+  }
+  EXPECT_TRUE(m.tracks().empty()) << "kept " << scans << " scans without an accepted update";
+  const double kept_s = static_cast<double>(s.t - last_update) * 1e-6;
+  EXPECT_GT(kept_s, s.params.coast_max_s);
+  EXPECT_LE(kept_s, s.params.parked_coast_max_s + 0.15);
+
+  // The same car given no returns: coasting from the first such scan.
+  Scans hidden;
+  SeeParkedCornerFor2s(&hidden);
+  hidden.t += kStep;
+  hidden.m.Miss(0);
+  hidden.m.EndScan(hidden.t);
+  ASSERT_EQ(hidden.m.tracks().size(), 1u);
+  EXPECT_EQ(hidden.m.tracks()[0].status, TrackStatus::kCoasting);
+}
+
 // The west 0.9 m of the same car's side, the rest hidden (a car passing in front): where along
 // the side that piece lies is not measured, so the same view scan after scan must not move the
 // parked car's track along its side (its middle, 1.7 m west of the car's centre, pulled it: the

@@ -270,7 +270,9 @@ TEST(TrackerBoxes, TrackScoreIsTheRecencyWeightedMeanOfItsBoxesScores) {
       ++checked;
     }
     const auto& tr = out[0].tracks;
-    if (k >= 5) EXPECT_EQ(tr[0].y > 0.0, tr[0].score > tr[1].score) << "frame " << k;
+    if (k >= 5) {
+      EXPECT_EQ(tr[0].y > 0.0, tr[0].score > tr[1].score) << "frame " << k;
+    }
   }
   EXPECT_EQ(checked, 30);
 }

@@ -110,7 +110,9 @@ TEST(TrackerTest, TracksParkedAndTurningCarsWithoutIdentitySwitch) {
       const double n = r.num_updates, c = params.manager.confirm_updates;
       EXPECT_NEAR(r.score, n / (n + c), 1e-12);
       EXPECT_TRUE(std::isnan(r.z) && std::isnan(r.height));  // no box measured it
-      if (r.status == TrackStatus::kConfirmed) EXPECT_GE(r.score, 0.5);
+      if (r.status == TrackStatus::kConfirmed) {
+        EXPECT_GE(r.score, 0.5);
+      }
     }
   }
 }

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 #include <utility>
 
 #include "base/angle.h"
@@ -86,6 +87,15 @@ void TurnAcrossFace(const Ekf& ekf, const PointSet& points, const Eigen::Vector2
 
 }  // namespace
 
+namespace {
+
+// [m] A face is shorter than the object's estimate along it (ShapeEstimator) by more than this
+// only if part of it is unseen: three times the shape histogram's smoothing std (0.15 m, the
+// noise of one dimension measurement).
+constexpr double kFaceShorterThanSeenMargin = 0.5;
+
+}  // namespace
+
 void AlignToFullFace(const Ekf& ekf, const TrackManagerParams& params, const PointSet& points,
                      const Eigen::Vector2d& sensor_xy, std::uint64_t seed,
                      const RangeProfile& profile, TrackMeasurer* measurer, Track* t) {
@@ -103,6 +113,11 @@ void AlignToFullFace(const Ekf& ekf, const TrackManagerParams& params, const Poi
     const double face_dir = std::atan2((b - a).y(), (b - a).x());
     const double theta = sel.filter.x(4);
     const bool along = std::abs(std::sin(AngleDiff(theta, face_dir))) < std::sin(DegToRad(45.0));
+    // The object was seen longer along this face before: this view of it is not whole (the far
+    // part of a side that runs away from the sensor is missing, and the profile cannot tell:
+    // what lies beyond it is farther, not nearer).
+    const std::optional<double>& seen = along ? sel.length_est : sel.width_est;
+    if (seen && *seen > extent + kFaceShorterThanSeenMargin) continue;
     if (along) TurnAcrossFace(ekf, points, sensor_xy, seed, measurer, t);
     t->axis_from_full_face = true;
     t->full_face_extent = extent;

@@ -36,7 +36,8 @@ void AlignVasmToMotion(Track* t);
 void AlignToShape(const Ekf& ekf, const TrackManagerParams& params, Track* t);
 
 // A fitted face seen whole (free space or only farther returns just beyond both ends, in the
-// scan's range profile) and shorter than vehicle_min_length is a front or rear face: the heading
+// scan's range profile), shorter than vehicle_min_length and not shorter than the shape estimate
+// along it (by more than 0.5 m: then part of it was unseen) is a front or rear face: the heading
 // is across it. If the heading ran along it, the ISM hypotheses turn by 90 deg and are measured
 // afresh (the centre moves with the axis). Sets t->axis_from_full_face and the face's extent.
 void AlignToFullFace(const Ekf& ekf, const TrackManagerParams& params, const PointSet& points,

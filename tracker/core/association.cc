@@ -387,8 +387,12 @@ void Associator::CandidatePairs(const std::vector<PredictedObject>& tracks, cons
     sorted_.Build(part_lo, part_hi, {});
   }
   const double slant = DegToRad(params_.min_slant_deg);
+  const auto inside_returns = [this](const Pair& pr) {
+    return pr.inside * static_cast<double>(parts_[static_cast<std::size_t>(pr.part)].points.size());
+  };
   Eigen::Vector2d lo, hi;
   for (std::size_t j = 0; j < tracks.size(); ++j) {
+    const std::size_t first = pairs->size();
     const double margin = GateMargin(tracks[j]);
     GateBounds(tracks[j].box, margin, &lo, &hi);
     sorted_.Overlapping(lo, hi, &candidates_);
@@ -404,6 +408,14 @@ void Associator::CandidatePairs(const std::vector<PredictedObject>& tracks, cons
       double inside = 0.0;
       const double c = PairCost(tracks[j], margin, visible, parts_[q], pts, &inside);
       if (std::isfinite(c)) pairs->push_back({static_cast<int>(j), static_cast<int>(q), c, inside});
+    }
+    // The returns of the track's candidates inside its gate that a part leaves unexplained: a
+    // few returns of one face must not win the track over the rest of its object.
+    double gate_returns = 0.0;
+    for (std::size_t k = first; k < pairs->size(); ++k) gate_returns += inside_returns((*pairs)[k]);
+    for (std::size_t k = first; k < pairs->size(); ++k) {
+      Pair& pr = (*pairs)[k];
+      pr.cost += params_.outside_penalty * (1.0 - inside_returns(pr) / gate_returns);
     }
   }
 }

@@ -174,8 +174,35 @@ TEST(AssociatorTest, PrefersReturnsOnTheVisibleFaces) {
   assoc.Run({t}, pts, segs, sensor, &res);
   ASSERT_FALSE(res.track_points[0].empty());
   // The assigned part is the rear face (indices 0..18); the front part is merged afterwards
-  // (it lies fully inside the gate), so check the assignment's cost is the rear face's: ~0.
-  EXPECT_LT(res.track_cost[0], 0.05);
+  // (it lies fully inside the gate), so check the assignment's cost is the rear face's: ~0 from
+  // its distance to the faces, and outside_penalty x the half of the gate's returns it leaves.
+  EXPECT_NEAR(res.track_cost[0], params.outside_penalty * 0.5, 0.05);
+}
+
+TEST(AssociatorTest, AFewReturnsOnAFaceDoNotWinTheTrackOverTheRestOfItsObject) {
+  // The sensor behind-left of a parked car's track (rear and left faces visible), whose shape
+  // is known only from a partial view (1 m x 0.5 m seen). In its gate: 4 returns exactly on the
+  // rear face (a fragment), and the car's side, 60 returns 0.3 m outside the predicted left
+  // face. By face distance alone the fragment wins (0 against 0.3 m); the side, stretching the
+  // track beyond what it has seen, cannot merge then and is ignored on its rectangle: the car's
+  // returns are lost. With the share of the gate's returns left unexplained, the side wins.
+  const Eigen::Vector2d sensor(-10, 5);
+  PredictedObject t = Pred(0.0, 0.0, 0.0);
+  t.seen_length = 1.0;
+  t.seen_width = 0.5;
+  WorldPoints pts;
+  for (int i = 0; i < 4; ++i) pts.push_back(-2.25, -0.2 + 0.1 * i, 1.0f, 0, 0);
+  for (int i = 0; i < 60; ++i) pts.push_back(-2.0 + 3.9 * i / 59.0, 1.2, 1.0f, 0, 0);
+  const Segments segs = SegmentsOf(pts, {{0, 4}, {4, 64}});
+  AssociationParams params;
+  Associator assoc(params);
+  AssociationResult res;
+  assoc.Run({t}, pts, segs, sensor, &res);
+  // Assigned: the side, at its face distance plus the 4 of 64 gate returns it leaves.
+  EXPECT_NEAR(res.track_cost[0], 0.3 + params.outside_penalty * 4.0 / 64.0, 1e-3);
+  int side = 0;
+  for (const std::int32_t i : res.track_points[0]) side += i >= 4;
+  EXPECT_EQ(side, 60);
 }
 
 // First hit of the ray from `sensor` at bearing `b` on the faces of `boxes`: the box index, or

@@ -3,7 +3,7 @@
 // confirmed track is coasting on a scan that gave it no returns (one given returns that updated
 // none of its hypotheses stays confirmed); deleted coast_max_s after its last accepted update
 // (parked_coast_max_s for a parked object) or once its position is less certain than max_position_std; of two
-// overlapping tracks one goes.
+// overlapping tracks one goes (MarkDuplicates).
 #pragma once
 
 #include <cstdint>
@@ -26,7 +26,9 @@ bool AdvanceStatus(const Ekf& ekf, const TrackManagerParams& params, std::int64_
 
 // Marks in *remove one of every two tracks whose rectangles (boxes, same order as tracks)
 // overlap by more than duplicate_overlap of the smaller one: a small object inside a vehicle's
-// rectangle, else the one with fewer updates, else the younger.
+// rectangle, else (both with vehicle evidence) the one with less of it, else the one with fewer
+// updates, else the younger. A track started on a tall thin object beside a car, older than the
+// car's own track, would otherwise take the car's place and its class.
 void MarkDuplicates(const TrackManagerParams& params, const std::vector<Track>& tracks,
                     const std::vector<PredictedObject>& boxes, std::vector<char>* remove);
 

@@ -1,0 +1,63 @@
+// MarkDuplicates (life_cycle.h): which of two tracks on one object goes. The tracks are built by
+// hand, the rectangles placed so that their overlap is known.
+#include "tracker/core/life_cycle.h"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+namespace vtrack {
+namespace {
+
+Track MakeTrack(std::int64_t id, int num_updates, bool evidence_seen, double log_odds) {
+  Track t;
+  t.id = id;
+  t.status = TrackStatus::kConfirmed;
+  t.num_updates = num_updates;
+  t.evidence_seen = evidence_seen;
+  t.vehicle_log_odds = log_odds;
+  return t;
+}
+
+PredictedObject Rect(double x, double y, double length = 4.5, double width = 1.8) {
+  PredictedObject p;
+  p.box.center = {x, y};
+  p.box.theta = 0.0;
+  p.box.length = length;
+  p.box.width = width;
+  return p;
+}
+
+std::vector<char> Duplicates(const std::vector<Track>& tracks, const std::vector<PredictedObject>& boxes) {
+  std::vector<char> remove(tracks.size(), 0);
+  MarkDuplicates(TrackManagerParams{}, tracks, boxes, &remove);
+  return remove;
+}
+
+TEST(LifeCycleTest, OfTwoDuplicatesTheOneWithLessVehicleEvidenceGoes) {
+  // Two rectangles 0.3 m apart along their length: 93% of either lies in the other.
+  const std::vector<PredictedObject> boxes = {Rect(0.0, 0.0), Rect(0.3, 0.0)};
+  ASSERT_GT(Overlap(boxes[0].box, boxes[1].box), TrackManagerParams{}.duplicate_overlap);
+  // The older track (35 updates) started on a pole beside the car: little vehicle evidence.
+  const Track pole_first = MakeTrack(1, 35, true, -3.0), car = MakeTrack(2, 14, true, 1.2);
+  EXPECT_EQ(Duplicates({pole_first, car}, boxes), (std::vector<char>{1, 0}));
+  EXPECT_EQ(Duplicates({car, pole_first}, boxes), (std::vector<char>{0, 1}));
+  // Without evidence on one of them (a detector's box alone measured it): the one with more
+  // updates stays, then the older one.
+  Track unseen = car;
+  unseen.evidence_seen = false;
+  EXPECT_EQ(Duplicates({pole_first, unseen}, boxes), (std::vector<char>{0, 1}));
+  Track same = MakeTrack(3, 35, true, -3.0);
+  EXPECT_EQ(Duplicates({same, pole_first}, boxes), (std::vector<char>{1, 0}));  // id 3 is younger
+  // A small object inside a vehicle's rectangle goes whatever its evidence.
+  Track small = MakeTrack(4, 50, true, 4.0);
+  small.small_object = true;
+  EXPECT_EQ(Duplicates({small, car}, {Rect(0.5, 0.2, 0.5, 0.5), Rect(0.0, 0.0)}),
+            (std::vector<char>{1, 0}));
+  // Rectangles side by side (1 m gap): no duplicates.
+  EXPECT_EQ(Duplicates({pole_first, car}, {Rect(0.0, 0.0), Rect(0.0, 2.8)}),
+            (std::vector<char>{0, 0}));
+}
+
+}  // namespace
+}  // namespace vtrack

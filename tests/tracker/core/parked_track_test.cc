@@ -111,18 +111,24 @@ TEST(ParkedTrackTest, MissedParkedTrackIsLookedForWhereItWasWithoutGateGrowthAnd
   EXPECT_LE(static_cast<double>(t - last_update) * 1e-6, params.parked_coast_max_s + 0.15);
 }
 
+// Returns of the parked car at (20, 5) at the world points xy, relative to its centre, spanning
+// extent [m].
+PointSet CarReturns(std::int64_t utime, const std::vector<Eigen::Vector2d>& xy, double extent) {
+  PointSet p;
+  p.origin = Eigen::Vector2d(20.0, 5.0);
+  for (const Eigen::Vector2d& q : xy) {
+    p.x.push_back(static_cast<float>(q.x() - p.origin.x()));
+    p.y.push_back(static_cast<float>(q.y() - p.origin.y()));
+  }
+  p.mean_utime = utime;
+  p.extent = extent;
+  return p;
+}
+
 // Three returns on the car's rear face: too few for a fit (FitParams::min_points), so they give
 // the track no accepted update.
 PointSet TooFewToFit(std::int64_t utime) {
-  PointSet p;
-  p.origin = Eigen::Vector2d(20.0, 5.0);
-  for (double y : {4.6, 5.0, 5.4}) {
-    p.x.push_back(static_cast<float>(17.75 - 20.0));
-    p.y.push_back(static_cast<float>(y - 5.0));
-  }
-  p.mean_utime = utime;
-  p.extent = 0.8;
-  return p;
+  return CarReturns(utime, {{17.75, 4.6}, {17.75, 5.0}, {17.75, 5.4}}, 0.8);
 }
 
 // The status says whether a scan saw the object, not whether it moved its state: a confirmed
@@ -166,15 +172,9 @@ TEST(ParkedTrackTest, ReturnsWithoutAnAcceptedUpdateKeepItConfirmedButDoNotKeepI
 // parked car's track along its side (its middle, 1.7 m west of the car's centre, pulled it: the
 // track ended 1.9 m west without the rule).
 PointSet HiddenButForTheSidesWestEnd(std::int64_t utime) {
-  PointSet p;
-  p.origin = Eigen::Vector2d(20.0, 5.0);
-  for (double x = 17.85; x <= 18.75 + 1e-9; x += 0.05) {
-    p.x.push_back(static_cast<float>(x - 20.0));
-    p.y.push_back(static_cast<float>(4.1 - 5.0));
-  }
-  p.mean_utime = utime;
-  p.extent = 0.9;
-  return p;
+  std::vector<Eigen::Vector2d> side;
+  for (double x = 17.85; x <= 18.75 + 1e-9; x += 0.05) side.emplace_back(x, 4.1);
+  return CarReturns(utime, side, 0.9);
 }
 
 TEST(ParkedTrackTest, PartialViewOfAParkedCarKeepsItsTrackInPlace) {

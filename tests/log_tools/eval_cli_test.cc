@@ -173,12 +173,24 @@ TEST_F(EvalCliTest, TrackLabelsFileLeavesTheScoresAlone) {
     last_utime = utime;
     const int id = std::stoi(f[1]);
     const std::string label_truth = f[2] + "," + f[4] + "," + f[5];
-    if (id == 1 || id == 2) EXPECT_EQ(label_truth, "1," + f[1] + ",1") << line;  // cars A, B
-    if (id == 3) EXPECT_EQ(label_truth, "0,-1,-1") << line;       // other, far from everything
-    if (id == 4) EXPECT_EQ(label_truth, "0,3,5") << line;         // on the pedestrian
-    if (id == 5) EXPECT_EQ(label_truth, "-1,4,1") << line;        // on the unlabelled car
-    if (id == 2) EXPECT_NEAR(std::stod(f[6]), 0.0, 1e-9) << line;
-    if (id == 3) EXPECT_NEAR(std::stod(f[3]), std::hypot(50.0, 50.0), 1e-6) << line;  // ego at 0
+    if (id == 1 || id == 2) {  // cars A, B
+      EXPECT_EQ(label_truth, "1," + f[1] + ",1") << line;
+    }
+    if (id == 3) {  // other, far from everything
+      EXPECT_EQ(label_truth, "0,-1,-1") << line;
+    }
+    if (id == 4) {  // on the pedestrian
+      EXPECT_EQ(label_truth, "0,3,5") << line;
+    }
+    if (id == 5) {  // on the unlabelled car
+      EXPECT_EQ(label_truth, "-1,4,1") << line;
+    }
+    if (id == 2) {
+      EXPECT_NEAR(std::stod(f[6]), 0.0, 1e-9) << line;
+    }
+    if (id == 3) {  // ego at 0
+      EXPECT_NEAR(std::stod(f[3]), std::hypot(50.0, 50.0), 1e-6) << line;
+    }
   }
   EXPECT_EQ(rows, 7 * kScans);
 }

@@ -576,7 +576,9 @@ void LoggerRecordsEverySweep(bool sliced) {
               largest / 1e6, sweep_max / 1e6);
   EXPECT_GE(sweep_bytes.size(), static_cast<std::size_t>(duration * 10) - 2);
   EXPECT_GT(sweep_max, 2'000'000u);
-  if (sliced) EXPECT_LE(largest, static_cast<std::size_t>(lcm_util::kMaxDatagramMessageBytes));
+  if (sliced) {
+    EXPECT_LE(largest, static_cast<std::size_t>(lcm_util::kMaxDatagramMessageBytes));
+  }
   EXPECT_EQ(got.size(), want.size());
   int differ = 0;
   for (const auto& [key, bytes] : want) differ += !got.count(key) || got.at(key) != bytes;

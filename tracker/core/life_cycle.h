@@ -1,7 +1,7 @@
 // A track's life cycle (track_manager.h, "Life cycle"): tentative -> confirmed after
 // confirm_updates updates, deleted after tentative_max_misses misses while tentative; a
-// confirmed track is coasting on a scan that gave it no returns (one given returns that updated
-// none of its hypotheses stays confirmed); deleted coast_max_s after its last accepted update
+// confirmed track is coasting on a scan that neither updated it nor gave it returns (one given
+// returns that updated none of its hypotheses stays confirmed); deleted coast_max_s after its last accepted update
 // (parked_coast_max_s for a parked object) or once its position is less certain than max_position_std; of two
 // overlapping tracks one goes (MarkDuplicates).
 #pragma once

@@ -90,8 +90,8 @@ void TurnAcrossFace(const Ekf& ekf, const PointSet& points, const Eigen::Vector2
 namespace {
 
 // [m] A face is shorter than the object's estimate along it (ShapeEstimator) by more than this
-// only if part of it is unseen: three times the shape histogram's smoothing std (0.15 m, the
-// noise of one dimension measurement).
+// only if part of it is unseen: about three times the shape histogram's smoothing std (0.15 m,
+// the noise of one dimension measurement).
 constexpr double kFaceShorterThanSeenMargin = 0.5;
 
 }  // namespace

@@ -50,7 +50,8 @@
 // starts with the reported hypothesis' score history.
 //
 // Axis of a stationary object. A fitted face whose both ends are seen (RangeProfile: beyond each
-// end, nothing nearer) and that is shorter than vehicle_min_length is a front or rear face: the
+// end, nothing nearer), shorter than vehicle_min_length and not shorter by more than 0.5 m than
+// the shape estimate along it (then part of it is unseen) is a front or rear face: the
 // heading is turned by 90 deg if it runs along that face, and kept so (a parked row seen from
 // behind shows full rear faces and the first metre of each side; the longer-edge rule would
 // take the rear face for a side). Otherwise the length axis is the longer side: when the width
@@ -59,10 +60,11 @@
 //
 // Life cycle. tentative -> confirmed after confirm_updates updates; a tentative track missed in
 // tentative_max_misses consecutive scans is deleted. A confirmed track is reported confirmed
-// while scans give it returns, and coasting on a scan that gives it none. The status says
-// whether the object was seen, not whether its state moved: returns that update none of its
-// hypotheses (outside the gate, too few to fit) still show the object there (KITTI 0000, mht,
-// seeds 1-5: MOTA 0.58 -> 0.63; urban_intersection 0.86 -> 0.89). It is deleted after coast_max_s without an update (a parked object: not a mover,
+// on a scan that updates it or gives it returns, and coasting on one that does neither (a
+// track in a lost wedge is not missed). The status says whether the object was seen, not
+// whether its state moved: returns that update none of its hypotheses (a measurement outside
+// the filter's NIS gate, too few returns to fit) still show the object there. It is deleted
+// after coast_max_s without an accepted update (a parked object: not a mover,
 // slower than mover_min_speed, after parked_coast_max_s: stopped traffic may hide it for longer)
 // or when its position std exceeds max_position_std. A parked object missed on the previous scan
 // is looked for where it was last measured, in its rectangle grown by the association's

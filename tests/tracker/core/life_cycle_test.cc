@@ -35,7 +35,7 @@ std::vector<char> Duplicates(const std::vector<Track>& tracks, const std::vector
 }
 
 TEST(LifeCycleTest, OfTwoDuplicatesTheOneWithLessVehicleEvidenceGoes) {
-  // Two rectangles 0.3 m apart along their length: 93% of either lies in the other.
+  // Two rectangles 0.3 m apart along their length: each lies almost wholly in the other.
   const std::vector<PredictedObject> boxes = {Rect(0.0, 0.0), Rect(0.3, 0.0)};
   ASSERT_GT(Overlap(boxes[0].box, boxes[1].box), TrackManagerParams{}.duplicate_overlap);
   // The older track (35 updates) started on a pole beside the car: little vehicle evidence.

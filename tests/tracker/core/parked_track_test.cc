@@ -268,8 +268,8 @@ TEST(ParkedTrackTest, ASideSeenShorterThanBeforeIsNotTakenForAnEndFace) {
   // a length estimate of about 4.5 m). Then the far part of the side goes missing (1.8 m of it
   // seen, nothing nearer beyond: the range profile cannot tell a missing part from free space),
   // and a post 10 m away hides the rear face's far end. The 1.8 m piece of the side is not a
-  // whole end face: the axis stays along the car (it turned by 90 deg, its centre 1.4 m off,
-  // before the shape estimate was asked).
+  // whole end face: the axis stays along the car (without asking the shape estimate it turns
+  // by 90 deg, its centre 1.4 m off).
   Scans s;
   ASSERT_TRUE(s.Create(ParkedCorner(s.t)));
   for (int k = 1; k <= 20; ++k) {

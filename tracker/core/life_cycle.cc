@@ -49,7 +49,8 @@ void MarkDuplicates(const TrackManagerParams& params, const std::vector<Track>& 
       const Track& b = tracks[j];
       bool drop_a;
       if (a.small_object != b.small_object) drop_a = a.small_object;
-      else if (a.evidence_seen && b.evidence_seen && a.vehicle_log_odds != b.vehicle_log_odds)
+      else if (a.status != TrackStatus::kTentative && b.status != TrackStatus::kTentative &&
+               a.evidence_seen && b.evidence_seen && a.vehicle_log_odds != b.vehicle_log_odds)
         drop_a = a.vehicle_log_odds < b.vehicle_log_odds;
       else if (a.num_updates != b.num_updates) drop_a = a.num_updates < b.num_updates;
       else drop_a = a.id > b.id;

@@ -26,8 +26,9 @@ bool AdvanceStatus(const Ekf& ekf, const TrackManagerParams& params, std::int64_
 
 // Marks in *remove one of every two tracks whose rectangles (boxes, same order as tracks)
 // overlap by more than duplicate_overlap of the smaller one: a small object inside a vehicle's
-// rectangle, else (both with vehicle evidence) the one with less of it, else the one with fewer
-// updates, else the younger. A track started on a tall thin object beside a car, older than the
+// rectangle, else (both confirmed or coasting, with vehicle evidence) the one with less of it,
+// else the one with fewer updates, else the younger (a tentative track's evidence is one or two
+// scans' worth). A track started on a tall thin object beside a car, older than the
 // car's own track, would otherwise take the car's place and its class.
 void MarkDuplicates(const TrackManagerParams& params, const std::vector<Track>& tracks,
                     const std::vector<PredictedObject>& boxes, std::vector<char>* remove);

@@ -70,7 +70,7 @@
 // is looked for where it was last measured, in its rectangle grown by the association's
 // gate_margin only: it does not move while hidden (Predict). Of two tracks whose rectangles overlap by more than duplicate_overlap of
 // the smaller one, one is deleted: a small object inside a vehicle's rectangle, else the one with
-// less vehicle evidence (both having some), else the one with fewer updates, else the younger. Ids are never reused within a run.
+// less vehicle evidence (both confirmed or coasting, with some), else the one with fewer updates, else the younger. Ids are never reused within a run.
 #pragma once
 
 #include <Eigen/Core>

@@ -47,6 +47,10 @@ TEST(LifeCycleTest, OfTwoDuplicatesTheOneWithLessVehicleEvidenceGoes) {
   Track unseen = car;
   unseen.evidence_seen = false;
   EXPECT_EQ(Duplicates({pole_first, unseen}, boxes), (std::vector<char>{0, 1}));
+  // A tentative track's evidence (a scan or two) does not decide: the one with more updates stays.
+  Track tentative = car;
+  tentative.status = TrackStatus::kTentative;
+  EXPECT_EQ(Duplicates({pole_first, tentative}, boxes), (std::vector<char>{0, 1}));
   Track same = MakeTrack(3, 35, true, -3.0);
   EXPECT_EQ(Duplicates({same, pole_first}, boxes), (std::vector<char>{1, 0}));  // id 3 is younger
   // A small object inside a vehicle's rectangle goes whatever its evidence.

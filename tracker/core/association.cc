@@ -409,13 +409,18 @@ void Associator::CandidatePairs(const std::vector<PredictedObject>& tracks, cons
       const double c = PairCost(tracks[j], margin, visible, parts_[q], pts, &inside);
       if (std::isfinite(c)) pairs->push_back({static_cast<int>(j), static_cast<int>(q), c, inside});
     }
-    // The returns of the track's candidates inside its gate that a part leaves unexplained: a
-    // few returns of one face must not win the track over the rest of its object.
-    double gate_returns = 0.0;
-    for (std::size_t k = first; k < pairs->size(); ++k) gate_returns += inside_returns((*pairs)[k]);
+    // The share of the track's candidate returns inside its gate that a part holds fewer of than
+    // the part holding the most: a few returns of one face must not win the track over the rest
+    // of its object. The part holding the most pays nothing, so the term decides which part the
+    // track takes, not whether it takes one (miss_cost).
+    double gate_returns = 0.0, most = 0.0;
+    for (std::size_t k = first; k < pairs->size(); ++k) {
+      gate_returns += inside_returns((*pairs)[k]);
+      most = std::max(most, inside_returns((*pairs)[k]));
+    }
     for (std::size_t k = first; k < pairs->size(); ++k) {
       Pair& pr = (*pairs)[k];
-      pr.cost += params_.outside_penalty * (1.0 - inside_returns(pr) / gate_returns);
+      pr.cost += params_.outside_penalty * (most - inside_returns(pr)) / gate_returns;
     }
   }
 }

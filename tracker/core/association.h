@@ -8,7 +8,8 @@
 //     cost = mean over inside returns of the distance to the nearest visible face of the
 //            predicted rectangle (Eq. 15 per-face visibility, docs/design.md note 4)
 //          + outside_penalty * (1 - inside fraction)
-//          + outside_penalty * (1 - its inside returns / all candidates' inside returns),
+//          + outside_penalty * (most inside returns of any candidate - its inside returns)
+//                            / all candidates' inside returns,
 // so a segment that lies where the sensor should see the vehicle's faces is preferred over one
 // that merely overlaps it, and a few returns on a face do not win the track over the rest of its
 // object (which, on the track's rectangle but beyond the dimensions it has seen, could then

@@ -177,7 +177,7 @@ struct AssociationParams {
     v("gate_sigma", &gate_sigma, {"-", AtLeast(0), "... plus this many predicted position standard deviations ..."});
     v("max_gate_margin", &max_gate_margin, {"m", AtLeast(0), "... at most this (>= gate_margin)"});
     v("min_inside_fraction", &min_inside_fraction, {"-", OpenClosed(0, 1), "share of a segment's returns inside the gate to be a candidate"});
-    v("outside_penalty", &outside_penalty, {"m", AtLeast(0), "cost per unit share of a segment's returns outside the gate, and per unit share of the gate's candidate returns the segment leaves out"});
+    v("outside_penalty", &outside_penalty, {"m", AtLeast(0), "cost per unit share of a segment's returns outside the gate, and per unit share of the gate's candidate returns it holds fewer of than the candidate holding most"});
     v("miss_cost", &miss_cost, {"m", Above(0), "cost of leaving a track unassigned"});
     v("merge_fraction", &merge_fraction, {"-", OpenClosed(0, 1), "a leftover segment joins an assigned track above this share inside"});
     v("ignore_max_extent", &ignore_max_extent, {"m", Closed(0, 10), "smaller leftovers inside a track's gate are ignored"});

@@ -585,6 +585,10 @@ enum class EvidenceFeature : std::int8_t {
   kInlierShare,    // [-] share of the fitted returns within the inlier threshold of the fitted
                    //     faces: a body panel is smooth at the range noise, foliage scatters its
                    //     returns through its depth; missing (NaN) if the scan gave no fit
+  kRoughness,      // [m] median distance of a return from the chord through its two neighbours
+                   //     along its ring (SurfaceRoughness): the range noise on a body panel or
+                   //     a wall, the depth a ray travels into foliage on a hedge or a crown;
+                   //     missing (NaN) with too few such triplets
   kCount
 };
 
@@ -595,7 +599,8 @@ struct vtrack::EnumNames<vtrack::EvidenceFeature> {
   static constexpr std::array kNames{"log_points", "log_range", "height_max", "height_median",
                                      "height_min", "column_top", "top_beam", "length", "width",
                                      "segment_extent", "hidden_ends", "speed", "mover", "small",
-                                     "length_unseen", "width_unseen", "inlier_share"};
+                                     "length_unseen", "width_unseen", "inlier_share",
+                                     "roughness"};
 };
 
 namespace vtrack {

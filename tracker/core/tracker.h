@@ -130,6 +130,7 @@ class Tracker {
     PointSet point_set;
     TrackMeasurer measurer;
     std::vector<float> evidence_scratch;
+    std::vector<RingReturn> roughness_scratch;
   };
   // What the update of one track adds to the scan's output (kept per track so that the
   // output's order does not depend on the threads).
@@ -172,9 +173,11 @@ class Tracker {
   std::vector<float> segment_extent_;     // [m] per segment: bounding-box diagonal
   int top_ring_ = -1;                     // TopRing of the scan being processed
   bool record_evidence_ = false;
-  // Whether the single-plane (0) and 3-D (1) evidence models use hidden_ends: only then (or when
-  // recording) are a track's ends looked up in the profile. Set once from the parameters.
+  // Whether the single-plane (0) and 3-D (1) evidence models use hidden_ends (roughness): only
+  // then (or when recording) are a track's ends looked up in the profile (its returns ordered
+  // along their rings). Set once from the parameters.
   bool hidden_ends_used_[2] = {false, false};
+  bool roughness_used_[2] = {false, false};
   std::int64_t returns_processed_ = 0;
   std::int64_t seed_ = 1;  // SetSeed
 };

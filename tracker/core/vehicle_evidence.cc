@@ -75,11 +75,49 @@ int HiddenEnds(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
          (profile.FreeBeyond(b, a, kEndOccluderMargin, kEndBinsBeyond) ? 0 : 1);
 }
 
+double SurfaceRoughness(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
+                        const Eigen::Vector2d& centroid, const Eigen::Vector2d& sensor_xy,
+                        std::vector<RingReturn>* order, std::vector<float>* distances) {
+  // Bearings as in HiddenEnds: tan of the offset from the centroid's, monotonic within +-90 deg.
+  const Eigen::Vector2d c = centroid - sensor_xy;
+  order->clear();
+  for (const std::int32_t i : idx) {
+    const auto k = static_cast<std::size_t>(i);
+    const double vx = pts.x[k] - sensor_xy.x(), vy = pts.y[k] - sensor_xy.y();
+    const double dot = c.x() * vx + c.y() * vy;
+    if (!(dot > 0.0)) continue;
+    order->push_back({pts.ring[k], (c.x() * vy - c.y() * vx) / dot, i});
+  }
+  std::sort(order->begin(), order->end(), [](const RingReturn& a, const RingReturn& b) {
+    return a.ring != b.ring ? a.ring < b.ring : a.bearing < b.bearing;
+  });
+  distances->clear();
+  const auto& o = *order;
+  for (std::size_t k = 0; k + 2 < o.size(); ++k) {
+    if (o[k].ring != o[k + 2].ring) continue;
+    const auto a = static_cast<std::size_t>(o[k].index), b = static_cast<std::size_t>(o[k + 1].index),
+               e = static_cast<std::size_t>(o[k + 2].index);
+    const double cx = pts.x[e] - pts.x[a], cy = pts.y[e] - pts.y[a];
+    const double chord = std::hypot(cx, cy);
+    if (!(chord > 1e-6) || chord > kRoughnessMaxChord) continue;
+    const double bx = pts.x[b] - pts.x[a], by = pts.y[b] - pts.y[a];
+    distances->push_back(static_cast<float>(std::abs(cx * by - cy * bx) / chord));
+  }
+  if (distances->size() < static_cast<std::size_t>(kRoughnessMinTriplets)) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  auto& d = *distances;
+  const auto half = static_cast<std::ptrdiff_t>(d.size() / 2);
+  std::nth_element(d.begin(), d.begin() + half, d.end());
+  return d[static_cast<std::size_t>(half)];
+}
+
 ReturnEvidence MeasureReturns(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
                               const std::vector<std::int32_t>& segment_of,
                               const std::vector<float>& segment_extent,
                               const Eigen::Vector2d& sensor_xy, bool three_d, int top_ring,
-                              const RangeProfile* profile, std::vector<float>* scratch) {
+                              const RangeProfile* profile, std::vector<float>* scratch,
+                              std::vector<RingReturn>* roughness) {
   ReturnEvidence r;
   r.three_d = three_d;
   r.num_points = static_cast<int>(idx.size());
@@ -102,6 +140,9 @@ ReturnEvidence MeasureReturns(const WorldPoints& pts, const std::vector<std::int
   r.segment_extent = extent;
   if (profile != nullptr && !profile->empty()) {
     r.hidden_ends = HiddenEnds(pts, idx, centroid, sensor_xy, *profile);
+  }
+  if (roughness != nullptr) {
+    r.roughness = SurfaceRoughness(pts, idx, centroid, sensor_xy, roughness, scratch);
   }
   if (!three_d) return r;
   auto& h = *scratch;
@@ -145,6 +186,7 @@ EvidenceFeatures FeaturesOf(const ReturnEvidence& r, const Track& t, double spee
           ? static_cast<double>(sel.fit.num_inliers) / static_cast<double>(sel.fit.point_edge.size())
           : kMissing);
   set(EvidenceFeature::kSegmentExtent, r.segment_extent);
+  set(EvidenceFeature::kRoughness, r.roughness);
   set(EvidenceFeature::kHiddenEnds, r.hidden_ends);
   // Speed from the reported hypothesis (bounded: a diverging filter says nothing more at 60 m/s).
   set(EvidenceFeature::kSpeed, std::isfinite(speed) ? std::min(30.0, std::abs(speed)) : 0.0);

@@ -59,7 +59,28 @@ struct ReturnEvidence {
   // return just beyond hides the end, or the object goes on at the same range (a wall seen in a
   // gap between parked cars: 2; a car seen whole: 0). NaN without a range profile.
   double hidden_ends = std::numeric_limits<double>::quiet_NaN();
+  double roughness = std::numeric_limits<double>::quiet_NaN();  // [m] SurfaceRoughness
 };
+
+// One return in SurfaceRoughness' order: by ring, then by bearing from the sensor.
+struct RingReturn {
+  std::int32_t ring;
+  double bearing;  // [-] monotonic in the bearing (tan of its offset from the centroid's)
+  std::int32_t index;
+};
+
+// [m] How far a track's returns scatter off a surface: over every three returns idx[a], idx[b],
+// idx[c] consecutive in bearing on one ring whose outer two lie within kRoughnessMaxChord of each
+// other, the distance (on the ground plane) of the middle one from the chord through the outer
+// two; their median. A smooth face (a body panel, a wall) gives the range noise, at any angle of
+// incidence; foliage gives the depth its rays travel in (a hedge, a crown). NaN with fewer than
+// kRoughnessMinTriplets such triplets. centroid: the returns' mean; order, distances: reused
+// buffers.
+double SurfaceRoughness(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
+                        const Eigen::Vector2d& centroid, const Eigen::Vector2d& sensor_xy,
+                        std::vector<RingReturn>* order, std::vector<float>* distances);
+constexpr double kRoughnessMaxChord = 1.0;  // [m] farther apart: not one surface between them
+constexpr int kRoughnessMinTriplets = 5;    // [-] fewer: no median worth the name
 
 // The ring of a 3-D scan's highest beam: the largest mean elevation over a sample of its returns
 // (ring numbers run up or down depending on the sensor and its driver); -1 for a single-plane
@@ -70,11 +91,13 @@ int TopRing(const LadarScan& scan);
 // none) and segment_extent[s] each segment's bounding-box diagonal; top_ring: TopRing of the
 // scan; profile: the scan's range profile (null or empty: hidden_ends stays NaN). scratch:
 // reused buffer.
+// roughness: null leaves ReturnEvidence::roughness NaN (not measured), else its scratch buffer.
 ReturnEvidence MeasureReturns(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
                               const std::vector<std::int32_t>& segment_of,
                               const std::vector<float>& segment_extent,
                               const Eigen::Vector2d& sensor_xy, bool three_d, int top_ring,
-                              const RangeProfile* profile, std::vector<float>* scratch);
+                              const RangeProfile* profile, std::vector<float>* scratch,
+                              std::vector<RingReturn>* roughness = nullptr);
 
 // Of the returns idx (centroid: their mean), the ends (extreme bearings from sensor_xy) that
 // are not free in profile (RangeProfile::FreeBeyond): 0, 1 or 2; 2 if they span no bearing.

@@ -243,6 +243,60 @@ TEST(VehicleEvidence, ReturnsGiveTheirHeightProfileColumnTopRangeAndSegmentExten
 // The ends of a track's returns, against a single-plane profile built here: a face 20 m ahead
 // seen alone has both ends free; a nearer return just beyond one end hides that end; the same
 // face inside a longer one at the same range (a wall seen in part) has neither end free.
+// Roughness against its distribution: returns on a straight face with independent normal
+// noise sigma across it, on two rings, given in shuffled order. The middle of three equally
+// spaced returns lies off the chord of the outer two by b - (a + c) / 2 ~ N(0, 1.5 sigma^2),
+// whose absolute value has the median 0.6745 sqrt(1.5) sigma. Returns farther apart than
+// kRoughnessMaxChord (the face's far piece) make no triplet with the near ones.
+TEST(VehicleEvidence, RoughnessIsTheMedianDistanceOffTheChordAlongARing) {
+  constexpr double kSigma = 0.03;  // [m]
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, kSigma);
+  WorldPoints pts;
+  // A face along y at x = 15, seen from the origin; returns every 0.1 m on rings 2 and 5.
+  for (const std::int16_t ring : {2, 5}) {
+    for (int k = 0; k < 1200; ++k) {
+      pts.push_back(15.0 + noise(rng), -60.0 + 0.1 * k, 1.0f, 0, ring);
+    }
+  }
+  std::vector<std::int32_t> idx(pts.size());
+  for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = static_cast<std::int32_t>(i);
+  std::shuffle(idx.begin(), idx.end(), rng);
+  double cx = 0.0, cy = 0.0;
+  for (const std::int32_t i : idx) {
+    cx += pts.x[static_cast<std::size_t>(i)] / static_cast<double>(idx.size());
+    cy += pts.y[static_cast<std::size_t>(i)] / static_cast<double>(idx.size());
+  }
+  std::vector<RingReturn> order;
+  std::vector<float> distances;
+  const Eigen::Vector2d sensor(0.0, 0.0), centroid(cx, cy);
+  const double expected = 0.6745 * std::sqrt(1.5) * kSigma;
+  // 2398 triplets: the sample median's standard error is ~3 % of it.
+  EXPECT_NEAR(SurfaceRoughness(pts, idx, centroid, sensor, &order, &distances), expected,
+              0.1 * expected);
+
+  // Every fourth return only: 0.4 m apart, still one surface (chords of 0.8 m).
+  std::vector<std::int32_t> sparse;
+  for (std::size_t i = 0; i < pts.size(); i += 4) sparse.push_back(static_cast<std::int32_t>(i));
+  EXPECT_NEAR(SurfaceRoughness(pts, sparse, centroid, sensor, &order, &distances), expected,
+              0.2 * expected);
+  // Every sixth: 0.6 m apart, chords of 1.2 m: no triplet, no roughness.
+  std::vector<std::int32_t> gaps;
+  for (std::size_t i = 0; i < pts.size(); i += 6) gaps.push_back(static_cast<std::int32_t>(i));
+  EXPECT_TRUE(std::isnan(SurfaceRoughness(pts, gaps, centroid, sensor, &order, &distances)));
+  // Four returns in a row (two triplets) are too few.
+  const std::vector<std::int32_t> four = {600, 601, 602, 603};
+  EXPECT_TRUE(std::isnan(SurfaceRoughness(pts, four, centroid, sensor, &order, &distances)));
+  // MeasureReturns measures it only when asked.
+  std::vector<std::int32_t> segment_of(pts.size(), -1);
+  std::vector<float> scratch;
+  EXPECT_TRUE(std::isnan(MeasureReturns(pts, idx, segment_of, {}, sensor, true, 0, nullptr, &scratch)
+                             .roughness));
+  EXPECT_NEAR(MeasureReturns(pts, idx, segment_of, {}, sensor, true, 0, nullptr, &scratch, &order)
+                  .roughness,
+              expected, 0.1 * expected);
+}
+
 TEST(VehicleEvidence, HiddenEndsCountsTheEndsThatAreNotFree) {
   const Eigen::Vector2d sensor(0.0, 0.0);
   const double step_deg = 0.5;  // the bearing step of the returns

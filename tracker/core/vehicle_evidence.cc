@@ -141,10 +141,10 @@ ReturnEvidence MeasureReturns(const WorldPoints& pts, const std::vector<std::int
   if (profile != nullptr && !profile->empty()) {
     r.hidden_ends = HiddenEnds(pts, idx, centroid, sensor_xy, *profile);
   }
-  if (roughness != nullptr) {
-    r.roughness = SurfaceRoughness(pts, idx, centroid, sensor_xy, roughness, scratch);
+  if (!three_d) {
+    if (roughness != nullptr) r.roughness = SurfaceRoughness(pts, idx, centroid, sensor_xy, roughness, scratch);
+    return r;
   }
-  if (!three_d) return r;
   auto& h = *scratch;
   const auto half = static_cast<std::ptrdiff_t>(h.size() / 2);
   const auto [lo, hi] = std::minmax_element(h.begin(), h.end());
@@ -160,6 +160,8 @@ ReturnEvidence MeasureReturns(const WorldPoints& pts, const std::vector<std::int
   } else {
     r.column_top = r.height_max;  // no grid ground: the returns' own top
   }
+  // Last: it reuses scratch, which held the heights.
+  if (roughness != nullptr) r.roughness = SurfaceRoughness(pts, idx, centroid, sensor_xy, roughness, scratch);
   return r;
 }
 

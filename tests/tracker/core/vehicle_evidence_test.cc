@@ -292,9 +292,23 @@ TEST(VehicleEvidence, RoughnessIsTheMedianDistanceOffTheChordAlongARing) {
   std::vector<float> scratch;
   EXPECT_TRUE(std::isnan(MeasureReturns(pts, idx, segment_of, {}, sensor, true, 0, nullptr, &scratch)
                              .roughness));
-  EXPECT_NEAR(MeasureReturns(pts, idx, segment_of, {}, sensor, true, 0, nullptr, &scratch, &order)
-                  .roughness,
-              expected, 0.1 * expected);
+  const ReturnEvidence with =
+      MeasureReturns(pts, idx, segment_of, {}, sensor, true, 0, nullptr, &scratch, &order);
+  EXPECT_NEAR(with.roughness, expected, 0.1 * expected);
+  // Measuring it leaves the other features as they are without it.
+  pts.height.assign(pts.size(), 0.0f);
+  for (std::size_t i = 0; i < pts.size(); ++i) pts.height[i] = 0.5f + 0.001f * static_cast<float>(i % 1000);
+  const ReturnEvidence a = MeasureReturns(pts, idx, segment_of, {}, sensor, true, 0, nullptr, &scratch);
+  const ReturnEvidence b =
+      MeasureReturns(pts, idx, segment_of, {}, sensor, true, 0, nullptr, &scratch, &order);
+  EXPECT_FLOAT_EQ(a.height_min, 0.5f);
+  EXPECT_FLOAT_EQ(a.height_max, 1.499f);
+  EXPECT_EQ(b.height_min, a.height_min);
+  EXPECT_EQ(b.height_max, a.height_max);
+  EXPECT_EQ(b.height_median, a.height_median);
+  EXPECT_EQ(b.column_top, a.column_top);
+  EXPECT_EQ(b.num_points, a.num_points);
+  EXPECT_EQ(b.range, a.range);
 }
 
 TEST(VehicleEvidence, HiddenEndsCountsTheEndsThatAreNotFree) {

@@ -18,6 +18,16 @@ namespace {
 // outlier return would only add leverage to the fit.
 constexpr float kMaxColumnTop = 10.0f;
 
+// The bearing of v (from the sensor) as its offset from c's, as tan(offset) = cross / dot:
+// monotonic in the offset within +-90 deg (a track's returns span far less), no atan2. False
+// (no offset) for v at 90 deg or more from c.
+inline bool BearingOffset(const Eigen::Vector2d& c, double vx, double vy, double* t) {
+  const double dot = c.x() * vx + c.y() * vy;
+  if (!(dot > 0.0)) return false;
+  *t = (c.x() * vy - c.y() * vx) / dot;
+  return true;
+}
+
 }  // namespace
 
 int TopRing(const LadarScan& scan) {
@@ -50,17 +60,15 @@ int TopRing(const LadarScan& scan) {
 int HiddenEnds(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
                const Eigen::Vector2d& centroid, const Eigen::Vector2d& sensor_xy,
                const RangeProfile& profile) {
-  // The extreme bearings about the centroid's: tan of the bearing offset, cross / dot, is
-  // monotonic in the offset within +-90 deg (a track's returns span far less), no atan2.
+  // The extreme bearings about the centroid's (BearingOffset).
   const Eigen::Vector2d c = centroid - sensor_xy;
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   Eigen::Vector2d a = centroid, b = centroid;
   for (const std::int32_t i : idx) {
     const Eigen::Vector2d p(pts.x[static_cast<std::size_t>(i)], pts.y[static_cast<std::size_t>(i)]);
     const Eigen::Vector2d v = p - sensor_xy;
-    const double dot = c.dot(v);
-    if (!(dot > 0.0)) continue;
-    const double t = (c.x() * v.y() - c.y() * v.x()) / dot;
+    double t;
+    if (!BearingOffset(c, v.x(), v.y(), &t)) continue;
     if (t < lo) {
       lo = t;
       a = p;
@@ -77,16 +85,17 @@ int HiddenEnds(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
 
 double SurfaceRoughness(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
                         const Eigen::Vector2d& centroid, const Eigen::Vector2d& sensor_xy,
-                        std::vector<RingReturn>* order, std::vector<float>* distances) {
-  // Bearings as in HiddenEnds: tan of the offset from the centroid's, monotonic within +-90 deg.
+                        bool three_d, std::vector<RingReturn>* order,
+                        std::vector<float>* distances) {
   const Eigen::Vector2d c = centroid - sensor_xy;
   order->clear();
   for (const std::int32_t i : idx) {
     const auto k = static_cast<std::size_t>(i);
-    const double vx = pts.x[k] - sensor_xy.x(), vy = pts.y[k] - sensor_xy.y();
-    const double dot = c.x() * vx + c.y() * vy;
-    if (!(dot > 0.0)) continue;
-    order->push_back({pts.ring[k], (c.x() * vy - c.y() * vx) / dot, i});
+    // A return of unknown ring (-1) in a 3-D cloud: its neighbours in bearing may lie on another.
+    if (three_d && pts.ring[k] < 0) continue;
+    double t;
+    if (!BearingOffset(c, pts.x[k] - sensor_xy.x(), pts.y[k] - sensor_xy.y(), &t)) continue;
+    order->push_back({three_d ? pts.ring[k] : std::int16_t{0}, t, i});
   }
   std::sort(order->begin(), order->end(), [](const RingReturn& a, const RingReturn& b) {
     return a.ring != b.ring ? a.ring < b.ring : a.bearing < b.bearing;
@@ -111,6 +120,31 @@ double SurfaceRoughness(const WorldPoints& pts, const std::vector<std::int32_t>&
   std::nth_element(d.begin(), d.begin() + half, d.end());
   return d[static_cast<std::size_t>(half)];
 }
+
+namespace {
+
+// The height profile and column top of the returns idx of a 3-D cloud; heights: theirs, in
+// idx order (reused as a buffer).
+void MeasureHeights(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
+                    ReturnEvidence* r, std::vector<float>* heights) {
+  auto& h = *heights;
+  const auto half = static_cast<std::ptrdiff_t>(h.size() / 2);
+  const auto [lo, hi] = std::minmax_element(h.begin(), h.end());
+  r->height_min = *lo;
+  r->height_max = *hi;
+  std::nth_element(h.begin(), h.begin() + half, h.end());
+  r->height_median = h[static_cast<std::size_t>(half)];
+  if (pts.column_top.size() == pts.size()) {
+    h.clear();
+    for (const std::int32_t i : idx) h.push_back(pts.column_top[static_cast<std::size_t>(i)]);
+    std::nth_element(h.begin(), h.begin() + half, h.end());
+    r->column_top = std::min(kMaxColumnTop, h[static_cast<std::size_t>(half)]);
+  } else {
+    r->column_top = r->height_max;  // no grid ground: the returns' own top
+  }
+}
+
+}  // namespace
 
 ReturnEvidence MeasureReturns(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
                               const std::vector<std::int32_t>& segment_of,
@@ -141,27 +175,11 @@ ReturnEvidence MeasureReturns(const WorldPoints& pts, const std::vector<std::int
   if (profile != nullptr && !profile->empty()) {
     r.hidden_ends = HiddenEnds(pts, idx, centroid, sensor_xy, *profile);
   }
-  if (!three_d) {
-    if (roughness != nullptr) r.roughness = SurfaceRoughness(pts, idx, centroid, sensor_xy, roughness, scratch);
-    return r;
+  if (three_d) MeasureHeights(pts, idx, &r, scratch);
+  // After the heights: it reuses scratch.
+  if (roughness != nullptr) {
+    r.roughness = SurfaceRoughness(pts, idx, centroid, sensor_xy, three_d, roughness, scratch);
   }
-  auto& h = *scratch;
-  const auto half = static_cast<std::ptrdiff_t>(h.size() / 2);
-  const auto [lo, hi] = std::minmax_element(h.begin(), h.end());
-  r.height_min = *lo;
-  r.height_max = *hi;
-  std::nth_element(h.begin(), h.begin() + half, h.end());
-  r.height_median = h[static_cast<std::size_t>(half)];
-  if (pts.column_top.size() == pts.size()) {
-    h.clear();
-    for (const std::int32_t i : idx) h.push_back(pts.column_top[static_cast<std::size_t>(i)]);
-    std::nth_element(h.begin(), h.begin() + half, h.end());
-    r.column_top = std::min(kMaxColumnTop, h[static_cast<std::size_t>(half)]);
-  } else {
-    r.column_top = r.height_max;  // no grid ground: the returns' own top
-  }
-  // Last: it reuses scratch, which held the heights.
-  if (roughness != nullptr) r.roughness = SurfaceRoughness(pts, idx, centroid, sensor_xy, roughness, scratch);
   return r;
 }
 

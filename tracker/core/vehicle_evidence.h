@@ -74,11 +74,13 @@ struct RingReturn {
 // other, the distance (on the ground plane) of the middle one from the chord through the outer
 // two; their median. A smooth face (a body panel, a wall) gives the range noise, at any angle of
 // incidence; foliage gives the depth its rays travel in (a hedge, a crown). NaN with fewer than
-// kRoughnessMinTriplets such triplets. centroid: the returns' mean; order, distances: reused
-// buffers.
+// kRoughnessMinTriplets such triplets. three_d: a 3-D cloud, whose returns of unknown ring (-1)
+// are left out (a single-plane scan's returns are all on its one ring, whatever their ring
+// field says). centroid: the returns' mean; order, distances: reused buffers.
 double SurfaceRoughness(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
                         const Eigen::Vector2d& centroid, const Eigen::Vector2d& sensor_xy,
-                        std::vector<RingReturn>* order, std::vector<float>* distances);
+                        bool three_d, std::vector<RingReturn>* order,
+                        std::vector<float>* distances);
 constexpr double kRoughnessMaxChord = 1.0;  // [m] farther apart: not one surface between them
 constexpr int kRoughnessMinTriplets = 5;    // [-] fewer: no median worth the name
 

@@ -272,21 +272,37 @@ TEST(VehicleEvidence, RoughnessIsTheMedianDistanceOffTheChordAlongARing) {
   const Eigen::Vector2d sensor(0.0, 0.0), centroid(cx, cy);
   const double expected = 0.6745 * std::sqrt(1.5) * kSigma;
   // 2398 triplets: the sample median's standard error is ~3 % of it.
-  EXPECT_NEAR(SurfaceRoughness(pts, idx, centroid, sensor, &order, &distances), expected,
+  EXPECT_NEAR(SurfaceRoughness(pts, idx, centroid, sensor, true, &order, &distances), expected,
               0.1 * expected);
 
   // Every fourth return only: 0.4 m apart, still one surface (chords of 0.8 m).
   std::vector<std::int32_t> sparse;
   for (std::size_t i = 0; i < pts.size(); i += 4) sparse.push_back(static_cast<std::int32_t>(i));
-  EXPECT_NEAR(SurfaceRoughness(pts, sparse, centroid, sensor, &order, &distances), expected,
+  EXPECT_NEAR(SurfaceRoughness(pts, sparse, centroid, sensor, true, &order, &distances), expected,
               0.2 * expected);
   // Every sixth: 0.6 m apart, chords of 1.2 m: no triplet, no roughness.
   std::vector<std::int32_t> gaps;
   for (std::size_t i = 0; i < pts.size(); i += 6) gaps.push_back(static_cast<std::int32_t>(i));
-  EXPECT_TRUE(std::isnan(SurfaceRoughness(pts, gaps, centroid, sensor, &order, &distances)));
+  EXPECT_TRUE(std::isnan(SurfaceRoughness(pts, gaps, centroid, sensor, true, &order, &distances)));
   // Four returns in a row (two triplets) are too few.
   const std::vector<std::int32_t> four = {600, 601, 602, 603};
-  EXPECT_TRUE(std::isnan(SurfaceRoughness(pts, four, centroid, sensor, &order, &distances)));
+  EXPECT_TRUE(std::isnan(SurfaceRoughness(pts, four, centroid, sensor, true, &order, &distances)));
+  // Ring 2 alone, its ring unknown (-1): left out of a 3-D cloud (its neighbours in bearing
+  // could be another ring's); a single-plane scan's one ring whatever its ring field says.
+  WorldPoints unknown = pts;
+  std::vector<std::int32_t> ring2;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (pts.ring[i] == 2) {
+      unknown.ring[i] = -1;
+      ring2.push_back(static_cast<std::int32_t>(i));
+    }
+  }
+  EXPECT_TRUE(std::isnan(SurfaceRoughness(unknown, ring2, centroid, sensor, true, &order, &distances)));
+  EXPECT_NEAR(SurfaceRoughness(unknown, ring2, centroid, sensor, false, &order, &distances), expected,
+              0.15 * expected);
+  // Both rings unknown in a 3-D cloud would interleave two rings: NaN, not a mixture.
+  for (auto& r : unknown.ring) r = -1;
+  EXPECT_TRUE(std::isnan(SurfaceRoughness(unknown, idx, centroid, sensor, true, &order, &distances)));
   // MeasureReturns measures it only when asked.
   std::vector<std::int32_t> segment_of(pts.size(), -1);
   std::vector<float> scratch;

@@ -984,7 +984,8 @@ Model RansacEdge(const Context& ctx, const Subset& sub, const FitParams& P, doub
     const Eigen::Vector2d nrm = Perp(u);
     double cost = 0.0;
     int inliers = 0;
-    for (int s = 0; s < S; ++s) {
+    // Terms are >= 0: once the sum reaches the best cost the sample cannot win.
+    for (int s = 0; s < S && cost < *best_cost; ++s) {
       const double r = nrm.x() * (sub.x[s] - mid.x()) + nrm.y() * (sub.y[s] - mid.y());
       const double ca = nrm.x() * sub.rx[s] + nrm.y() * sub.ry[s];
       const double e = r * r / ctx.Threshold2(ctx.PerpVar(ca));
@@ -1007,12 +1008,15 @@ Model RansacEdge(const Context& ctx, const Subset& sub, const FitParams& P, doub
   return AdaptiveRansac(P.max_edge_iterations, P.min_iterations, try_sample);
 }
 
-// The truncated cost of a corner over the subset, with the inliers of each edge.
+// The truncated cost of a corner over the subset, with the inliers of each edge; or any value
+// >= bound once the sum reaches bound (its terms are >= 0, so the full sum would too: the
+// sample cannot be the best, and the rest of the subset is not scored).
 double CornerCost(const Context& ctx, const Subset& sub, const Eigen::Vector2d& corner,
-                  const Eigen::Vector2d& u0, const Eigen::Vector2d& u1, int* n0, int* n1) {
+                  const Eigen::Vector2d& u0, const Eigen::Vector2d& u1, double bound, int* n0,
+                  int* n1) {
   double cost = 0.0;
   *n0 = *n1 = 0;
-  for (int s = 0; s < sub.size; ++s) {
+  for (int s = 0; s < sub.size && cost < bound; ++s) {
     const double vx = sub.x[s] - corner.x(), vy = sub.y[s] - corner.y();
     const double a0 = u0.x() * vx + u0.y() * vy;  // along edge 0 = residual of edge 1
     const double a1 = u1.x() * vx + u1.y() * vy;  // along edge 1 = residual of edge 0
@@ -1053,7 +1057,7 @@ Model RansacCorner(const Context& ctx, const Subset& sub, const FitParams& P, do
       const Eigen::Vector2d u0 = Cross(h.dir_a, h.dir_b) > 0.0 ? h.dir_a : h.dir_b;
       const Eigen::Vector2d u1 = Perp(u0);
       int n0 = 0, n1 = 0;
-      const double cost = CornerCost(ctx, sub, h.corner, u0, u1, &n0, &n1);
+      const double cost = CornerCost(ctx, sub, h.corner, u0, u1, *best_cost, &n0, &n1);
       if (cost < *best_cost) {
         *best_cost = cost;
         best->num_edges = 2;
@@ -1262,6 +1266,13 @@ Context MakeContext(const FitRequest& req, const FitParams& P, std::vector<doubl
 
 }  // namespace
 
+bool SegmentFitter::Consensus::Matches(const FitRequest& req) const {
+  return valid && seed == req.seed && range_sigma_m == req.range_sigma_m &&
+         sensor_xy == req.sensor_xy && x.size() == req.x.size() &&
+         std::equal(x.begin(), x.end(), req.x.begin()) &&
+         std::equal(y.begin(), y.end(), req.y.begin());
+}
+
 void SegmentFitter::Fit(const FitRequest& req, FitResult* out) {
   CheckRequest(req);
   const FitParams& P = params_;
@@ -1274,11 +1285,34 @@ void SegmentFitter::Fit(const FitRequest& req, FitResult* out) {
   const double slant = DegToRad(P.min_slant_deg);
   // A small-state engine: seeding std::mt19937 (2.5 kB of state) would cost more than a small
   // fit; minstd is plenty for drawing sample indices.
-  std::minstd_rand rng(static_cast<std::uint_fast32_t>((req.seed ^ (req.seed >> 32)) % 2147483646u) + 1u);
-  const Subset sub = DrawSubset(ctx, P.max_scoring_points, rng, &sx_, &sy_, &srx_, &sry_);
-  std::uniform_int_distribution<int> pick(0, sub.size - 1);
-  const Model best_edge = RansacEdge(ctx, sub, P, slant, pick, rng);
-  const Model best_corner = RansacCorner(ctx, sub, P, slant, pick, rng);
+  Model best_edge, best_corner;
+  if (consensus_.Matches(req)) {
+    best_edge.num_edges = consensus_.num_edges[0];
+    best_edge.c = consensus_.c[0];
+    best_edge.phi = consensus_.phi[0];
+    best_corner.num_edges = consensus_.num_edges[1];
+    best_corner.c = consensus_.c[1];
+    best_corner.phi = consensus_.phi[1];
+  } else {
+    std::minstd_rand rng(
+        static_cast<std::uint_fast32_t>((req.seed ^ (req.seed >> 32)) % 2147483646u) + 1u);
+    const Subset sub = DrawSubset(ctx, P.max_scoring_points, rng, &sx_, &sy_, &srx_, &sry_);
+    std::uniform_int_distribution<int> pick(0, sub.size - 1);
+    best_edge = RansacEdge(ctx, sub, P, slant, pick, rng);
+    best_corner = RansacCorner(ctx, sub, P, slant, pick, rng);
+    consensus_.x.assign(req.x.begin(), req.x.end());
+    consensus_.y.assign(req.y.begin(), req.y.end());
+    consensus_.sensor_xy = req.sensor_xy;
+    consensus_.range_sigma_m = req.range_sigma_m;
+    consensus_.seed = req.seed;
+    consensus_.num_edges[0] = best_edge.num_edges;
+    consensus_.c[0] = best_edge.c;
+    consensus_.phi[0] = best_edge.phi;
+    consensus_.num_edges[1] = best_corner.num_edges;
+    consensus_.c[1] = best_corner.c;
+    consensus_.phi[1] = best_corner.phi;
+    consensus_.valid = true;
+  }
   // Refinement on all points, then the choice between corner and edge: the best edge first, a
   // corner must explain what it cannot.
   Refiner r(ctx, req, P, out, &proj_, &gaps_);

@@ -196,6 +196,24 @@ class SegmentFitter {
   std::vector<double> proj_;                 // projections of one edge's inliers (sorting)
   std::vector<double> gaps_;                 // their spacings
   std::vector<std::int8_t> mask_;            // single edge: points marked ambiguous or excluded
+
+  // RANSAC's best edge and corner for the last request. They depend on its returns, sensor,
+  // range noise and seed only, not on the heading, shape or centre it predicts, and the
+  // hypotheses of one track are fitted to the same returns with the same seed: they draw their
+  // samples once. The key is compared in full (the returns element by element), so a hit gives
+  // exactly the models that drawing again would.
+  struct Consensus {
+    std::vector<float> x, y;
+    Eigen::Vector2d sensor_xy = Eigen::Vector2d::Zero();
+    double range_sigma_m = 0.0;
+    std::uint64_t seed = 0;
+    bool valid = false;
+    int num_edges[2] = {0, 0};  // [0] the edge, [1] the corner; 0: RANSAC found none
+    Eigen::Vector2d c[2] = {Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
+    double phi[2] = {0.0, 0.0};
+    bool Matches(const FitRequest& req) const;
+  };
+  Consensus consensus_;
 };
 
 // The three perpendicular corners defined by three points (Figure 3 b-d): for each point k, the

@@ -949,6 +949,62 @@ TEST(Fitting, DeterministicForASeedAndReusesTheResult) {
   EXPECT_EQ(rb.point_edge.size(), scan.size());
 }
 
+// The hypotheses of a track fit the same returns with the same seed and their own heading and
+// shape: a fitter reused across them (and across tracks whose returns differ in one point only)
+// gives what a fresh fitter gives for each request.
+TEST(Fitting, ReusedFitterGivesAFreshFittersResultForEveryRequest) {
+  std::mt19937 rng(112);
+  const OrientedBox truth{{12.0, -3.0}, DegToRad(30.0), 4.8, 1.9};  // a corner view
+  ScanSpec spec;
+  spec.truth = truth;
+  spec.outlier_fraction = 0.25;
+  spec.outlier_kind = OutlierKind::kClutter;
+  const SyntheticScan scan = MakeScan(spec, rng);
+  // The same returns turned by 20 deg about the sensor: another point set of the same size.
+  std::vector<float> turned_x(scan.size()), turned_y(scan.size());
+  const double c = std::cos(DegToRad(20.0)), s = std::sin(DegToRad(20.0));
+  for (std::size_t i = 0; i < scan.size(); ++i) {
+    const double dx = scan.x[i] - spec.sensor.x(), dy = scan.y[i] - spec.sensor.y();
+    turned_x[i] = static_cast<float>(spec.sensor.x() + c * dx - s * dy);
+    turned_y[i] = static_cast<float>(spec.sensor.y() + s * dx + c * dy);
+  }
+  std::vector<FitRequest> requests;
+  for (const double dtheta : {0.0, 0.5 * kPi, 0.1}) {
+    FitRequest r = TrackRequestFor(scan, spec, 7);
+    *r.predicted_theta += dtheta;
+    requests.push_back(r);
+  }
+  FitRequest unknown_shape = RequestFor(scan, spec, 7);
+  unknown_shape.shape_known = false;
+  unknown_shape.length_m = 4.5;
+  requests.push_back(unknown_shape);
+  FitRequest turned = requests[0];
+  turned.x = turned_x;
+  turned.y = turned_y;
+  requests.push_back(turned);
+  FitRequest other_sensor = requests[0];
+  other_sensor.sensor_xy += Eigen::Vector2d(0.5, -0.5);
+  requests.push_back(other_sensor);
+  FitRequest other_seed = requests[0];
+  other_seed.seed = 8;
+  requests.push_back(other_seed);
+  requests.push_back(requests[0]);
+  SegmentFitter reused;
+  int kinds[3] = {0, 0, 0};
+  for (std::size_t k = 0; k < requests.size(); ++k) {
+    SCOPED_TRACE(k);
+    FitResult got, want;
+    reused.Fit(requests[k], &got);
+    SegmentFitter().Fit(requests[k], &want);
+    ++kinds[static_cast<int>(want.kind)];
+    EXPECT_EQ(got.kind, want.kind);
+    EXPECT_EQ(got.z, want.z);
+    EXPECT_EQ(got.R, want.R);
+    EXPECT_EQ(got.point_edge, want.point_edge);
+  }
+  EXPECT_GE(kinds[static_cast<int>(FitKind::kCorner)], 4) << kinds[0] << " " << kinds[1];  // fits, not failures
+}
+
 TEST(Fitting, FarFromTheWorldOrigin) {
   // World coordinates of 1e4 m (a UTM-like frame): floats hold mm there, the fit must not lose
   // more.

@@ -923,14 +923,18 @@ TEST(Fitting, ParamsValidationNamesTheKey) {
   }
 }
 
+// A car seen at a corner 12 m away, with a share of clutter returns among its own.
+SyntheticScan CornerView(std::uint32_t seed, double outlier_fraction, ScanSpec* spec) {
+  std::mt19937 rng(seed);
+  spec->truth = OrientedBox{{12.0, -3.0}, DegToRad(30.0), 4.8, 1.9};
+  spec->outlier_fraction = outlier_fraction;
+  spec->outlier_kind = OutlierKind::kClutter;
+  return MakeScan(*spec, rng);
+}
+
 TEST(Fitting, DeterministicForASeedAndReusesTheResult) {
-  std::mt19937 rng(111);
-  const OrientedBox truth{{12.0, -3.0}, DegToRad(30.0), 4.8, 1.9};  // a corner view
   ScanSpec spec;
-  spec.truth = truth;
-  spec.outlier_fraction = 0.3;
-  spec.outlier_kind = OutlierKind::kClutter;
-  const SyntheticScan scan = MakeScan(spec, rng);
+  const SyntheticScan scan = CornerView(111, 0.3, &spec);
   FitRequest req = TrackRequestFor(scan, spec, 99);
   SegmentFitter a, b;
   FitResult ra, rb;
@@ -950,16 +954,11 @@ TEST(Fitting, DeterministicForASeedAndReusesTheResult) {
 }
 
 // The hypotheses of a track fit the same returns with the same seed and their own heading and
-// shape: a fitter reused across them (and across tracks whose returns differ in one point only)
-// gives what a fresh fitter gives for each request.
+// shape: a fitter reused across them (and across other returns of the same count, another
+// sensor position or seed) gives what a fresh fitter gives for each request.
 TEST(Fitting, ReusedFitterGivesAFreshFittersResultForEveryRequest) {
-  std::mt19937 rng(112);
-  const OrientedBox truth{{12.0, -3.0}, DegToRad(30.0), 4.8, 1.9};  // a corner view
   ScanSpec spec;
-  spec.truth = truth;
-  spec.outlier_fraction = 0.25;
-  spec.outlier_kind = OutlierKind::kClutter;
-  const SyntheticScan scan = MakeScan(spec, rng);
+  const SyntheticScan scan = CornerView(112, 0.25, &spec);
   // The same returns turned by 20 deg about the sensor: another point set of the same size.
   std::vector<float> turned_x(scan.size()), turned_y(scan.size());
   const double c = std::cos(DegToRad(20.0)), s = std::sin(DegToRad(20.0));

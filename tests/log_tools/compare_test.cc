@@ -60,7 +60,8 @@ TEST_F(CompareTest, HelpAndBadOptions) {
   EXPECT_NE(out.find("gate_m"), std::string::npos) << out;
   EXPECT_EQ(RunTool({"--scenarios", "a", "--kitti-dontcare", dir_ + "/labels.txt"}, &out), 2);
   EXPECT_NE(out.find("--kitti-dontcare is not an option here"), std::string::npos) << out;
-  EXPECT_EQ(RunTool({"--scenarios", "a", "--bin-dir", dir_ + "/nowhere"}, &out), 1);
+  EXPECT_EQ(RunTool({"--scenarios", "a", "--bin-dir", dir_ + "/nowhere"}, &out, {"TMPDIR=" + dir_}),
+            1);
   EXPECT_NE(out.find("vtrack-sim-log"), std::string::npos) << out;
 }
 
@@ -190,8 +191,11 @@ TEST_F(CompareTest, AKittiFolderOfAnotherSequenceIsScoredUnderItsOwnNumber) {
 TEST_F(CompareTest, AFailedModeIsReportedAndTheRestStillScored) {
   const std::string json = dir_ + "/cmp.json";
   std::string out;
+  // A failed run keeps its temporary work directory for inspection: here, inside the test's.
   EXPECT_EQ(RunTool({"--scenarios", "alpha,fail_sim", "--bin-dir", fake_bin_, "--json", json},
-                &out, {"FAKE_TRACKER_FAIL_MODE=vasm"}), 1) << out;
+                &out, {"FAKE_TRACKER_FAIL_MODE=vasm", "TMPDIR=" + dir_}), 1) << out;
+  EXPECT_NE(out.find("work directory kept: " + dir_ + "/vtrack-compare-"), std::string::npos)
+      << out;
   EXPECT_NE(out.find("mode vasm fails"), std::string::npos) << out;          // the child's output
   EXPECT_NE(out.find("scenario fail_sim fails"), std::string::npos) << out;
   EXPECT_NE(out.find("failed"), std::string::npos) << out;                   // in the table
@@ -274,7 +278,7 @@ TEST_F(CompareTest, SeveralSeedsGiveOneItemEachAndTheirSum) {
   // A seed whose run fails leaves the sum row failed, not summed over the others.
   ASSERT_EQ(RunTool({"--scenarios", "alpha", "--seeds", "1,2", "--modes", "ism,vasm", "--bin-dir",
                      fake_bin_, "--json", json},
-                    &out, {"FAKE_TRACKER_FAIL_MODE=vasm"}), 1) << out;
+                    &out, {"FAKE_TRACKER_FAIL_MODE=vasm", "TMPDIR=" + dir_}), 1) << out;
   const YAML::Node f = YAML::LoadFile(json);
   EXPECT_TRUE(f["alpha_seeds"]["ism"].IsMap());
   EXPECT_TRUE(f["alpha_seeds"]["vasm"].IsNull());

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <sstream>
@@ -1267,10 +1268,15 @@ Context MakeContext(const FitRequest& req, const FitParams& P, std::vector<doubl
 }  // namespace
 
 bool SegmentFitter::Consensus::Matches(const FitRequest& req) const {
-  return valid && seed == req.seed && range_sigma_m == req.range_sigma_m &&
-         sensor_xy == req.sensor_xy && x.size() == req.x.size() &&
-         std::equal(x.begin(), x.end(), req.x.begin()) &&
-         std::equal(y.begin(), y.end(), req.y.begin());
+  // Bit for bit, not by ==: -0.0 == 0.0, but a signed zero can turn an atan2 by 2 pi.
+  const auto same = [](const void* a, const void* b, std::size_t bytes) {
+    return bytes == 0 || std::memcmp(a, b, bytes) == 0;
+  };
+  return valid && seed == req.seed && x.size() == req.x.size() &&
+         same(&range_sigma_m, &req.range_sigma_m, sizeof(double)) &&
+         same(sensor_xy.data(), req.sensor_xy.data(), 2 * sizeof(double)) &&
+         same(x.data(), req.x.data(), x.size() * sizeof(float)) &&
+         same(y.data(), req.y.data(), y.size() * sizeof(float));
 }
 
 void SegmentFitter::Fit(const FitRequest& req, FitResult* out) {

@@ -200,7 +200,7 @@ class SegmentFitter {
   // RANSAC's best edge and corner for the last request. They depend on its returns, sensor,
   // range noise and seed only, not on the heading, shape or centre it predicts, and the
   // hypotheses of one track are fitted to the same returns with the same seed: they draw their
-  // samples once. The key is compared in full (the returns element by element), so a hit gives
+  // samples once. The key is compared in full, bit for bit (every return), so a hit gives
   // exactly the models that drawing again would.
   struct Consensus {
     std::vector<float> x, y;

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace vtrack {
 
@@ -30,6 +31,48 @@ std::optional<bool> MoverTest::Evidence(const Ekf& ekf, const Track& t, bool pos
     return d2 > d2_quantile_ && c.speed >= min_speed_;
   }
   return false;
+}
+
+namespace {
+
+// The stride that takes at most kMotionCheckPoints of n returns.
+std::size_t MotionCheckStride(std::size_t n) {
+  return std::max<std::size_t>(1, (n + kMotionCheckPoints - 1) / kMotionCheckPoints);
+}
+
+}  // namespace
+
+bool ReturnsMovedWith(const PointSet& now, const ReturnsSnapshot& before, const Eigen::Vector2d& d) {
+  // Brute force over at most 64 x 64 pairs: a k-d tree over 64 points costs more to build than
+  // this search.
+  const Eigen::Vector2d off = now.origin - before.origin;  // now's frame -> before's frame
+  const std::size_t stride = MotionCheckStride(now.size());
+  double still = 0.0, moved = 0.0;  // [m] summed nearest distances
+  for (std::size_t i = 0; i < now.size(); i += stride) {
+    const double px = now.x[i] + off.x(), py = now.y[i] + off.y();
+    double best_still = std::numeric_limits<double>::infinity(), best_moved = best_still;
+    for (std::size_t k = 0; k < before.x.size(); ++k) {
+      const double dx = px - before.x[k], dy = py - before.y[k];
+      best_still = std::min(best_still, dx * dx + dy * dy);
+      const double ex = dx - d.x(), ey = dy - d.y();
+      best_moved = std::min(best_moved, ex * ex + ey * ey);
+    }
+    still += std::sqrt(best_still);
+    moved += std::sqrt(best_moved);
+  }
+  return moved < still;
+}
+
+void Snapshot(const PointSet& points, ReturnsSnapshot* out) {
+  out->origin = points.origin;
+  out->utime = points.mean_utime;
+  out->x.clear();
+  out->y.clear();
+  const std::size_t stride = MotionCheckStride(points.size());
+  for (std::size_t i = 0; i < points.size(); i += stride) {
+    out->x.push_back(points.x[i]);
+    out->y.push_back(points.y[i]);
+  }
 }
 
 ObjectClass Classify(const TrackManagerParams& params, const EvidenceParams& evidence,

@@ -47,11 +47,21 @@ struct TrackHypothesis {
   }
 };
 
+// A few of one scan's returns of a track, kept for the next scan's motion check
+// (ReturnsMovedWith, classification.h). World position = origin + (x, y).
+struct ReturnsSnapshot {
+  Eigen::Vector2d origin = Eigen::Vector2d::Zero();  // [m] world
+  std::vector<float> x, y;                           // [m] relative to origin
+  std::int64_t utime = 0;                            // [us] mean measurement time of the returns
+  bool empty() const { return x.empty(); }
+};
+
 struct Track {
   std::int64_t id = 0;
   TrackStatus status = TrackStatus::kTentative;
   bool mover = false;
   int motion_evidence = 0;                // [-] consecutive scans with evidence of motion
+  ReturnsSnapshot last_returns;           // the returns of the last scan that measured it
   std::int64_t created_utime = 0;         // [us]
   std::int64_t state_utime = 0;           // [us] time of the hypotheses' states
   std::int64_t last_update_utime = 0;     // [us]

@@ -116,7 +116,8 @@ void TrackManager::Update(std::size_t index, const PointSet& points,
     GrowIntoRectangle(points, sensor_xy, seed, measurer, &t);
   }
   const bool any = UpdateHypotheses(points, sensor_xy, seed, tm, measurer, &t);
-  AfterUpdate(any, tm, /*pose_measured=*/false, &t);
+  AfterUpdate(any, tm, /*pose_measured=*/false, &points, &t);
+  Snapshot(points, &t.last_returns);
   if (any && !t.mover && !t.small_object && profile && !profile->empty()) {
     AlignToFullFace(ekf_, params_, points, sensor_xy, seed, *profile, measurer, &t);
   }
@@ -246,9 +247,14 @@ void TrackManager::ObserveShape(bool small, const PointSet& points, double time_
   h->RefreshShape();
 }
 
-void TrackManager::TestMotion(Track* t, bool pose_measured) const {
-  const std::optional<bool> evidence = mover_test_.Evidence(ekf_, *t, pose_measured);
+void TrackManager::TestMotion(Track* t, bool pose_measured, const PointSet* points) const {
+  std::optional<bool> evidence = mover_test_.Evidence(ekf_, *t, pose_measured);
   if (!evidence) return;  // no evidence either way: the count is kept
+  if (*evidence && points != nullptr && !t->last_returns.empty()) {
+    const CentreEstimate c = ekf_.Centre(t->hyps[static_cast<std::size_t>(t->selected)].filter);
+    const double dt = static_cast<double>(points->mean_utime - t->last_returns.utime) * 1e-6;
+    evidence = ReturnsMovedWith(*points, t->last_returns, c.velocity * dt);
+  }
   t->motion_evidence = *evidence ? t->motion_evidence + 1 : 0;
   if (!t->mover && t->motion_evidence >= params_.mover_scans) {
     t->mover = true;
@@ -295,10 +301,11 @@ void TrackManager::UpdateWithBox(std::size_t index, const BoxMeasurement& b,
     t.last_box_utime = b.utime;
     t.small_object = false;  // the box is a full view of a vehicle's rectangle
   }
-  AfterUpdate(any, tm, /*pose_measured=*/true, &t);
+  AfterUpdate(any, tm, /*pose_measured=*/true, /*points=*/nullptr, &t);
 }
 
-void TrackManager::AfterUpdate(bool any, std::int64_t utime, bool pose_measured, Track* t) {
+void TrackManager::AfterUpdate(bool any, std::int64_t utime, bool pose_measured,
+                               const PointSet* points, Track* t) {
   if (any) {
     ++t->num_updates;
     t->consecutive_misses = 0;
@@ -308,7 +315,7 @@ void TrackManager::AfterUpdate(bool any, std::int64_t utime, bool pose_measured,
   }
   SelectHypothesis(params_.switch_margin, t);
   ReseedFailedHypotheses(ekf_, params_.fail_misses, t);
-  if (any) TestMotion(t, pose_measured);
+  if (any) TestMotion(t, pose_measured, points);
 }
 
 void TrackManager::ObserveBoxShape(const BoxMeasurement& b, double time_s,
@@ -402,6 +409,7 @@ bool TrackManager::Create(const PointSet& points, const Eigen::Vector2d& sensor_
   if (!m.z.allFinite() || !m.R.allFinite()) return false;
   StartFilter(m, &h);
   ObserveFirstShape(t.small_object, points, &h);
+  Snapshot(points, &t.last_returns);
   AddTrack(std::move(t), std::move(h), points.mean_utime);
   return true;
 }

@@ -169,16 +169,20 @@ class TrackManager {
   void ObserveShape(bool small, const PointSet& points, double time_s, TrackHypothesis* h) const;
   void ObserveFirstShape(bool small, const PointSet& points, TrackHypothesis* h) const;
   // After the hypotheses' updates at utime (any: one was accepted): counts, the reported
-  // hypothesis, re-seeding, the mover test.
-  void AfterUpdate(bool any, std::int64_t utime, bool pose_measured, Track* t);
+  // hypothesis, re-seeding, the mover test. points: the returns that measured it (nullptr: a
+  // detector's box).
+  void AfterUpdate(bool any, std::int64_t utime, bool pose_measured, const PointSet* points,
+                   Track* t);
   // A new track: its first hypothesis (shape, inside fraction), its filter started from the
   // first measurement with that measurement's score term, and the track added with the next id.
   TrackHypothesis FirstHypothesis() const;
   void StartFilter(const CentreMeasurement& m, TrackHypothesis* h) const;
   void AddTrack(Track t, TrackHypothesis h, std::int64_t utime);
   // The mover test on this scan, and what follows a mover declaration. pose_measured: the
-  // update measured the whole pose (a detector's box), not a fit of the returns.
-  void TestMotion(Track* t, bool pose_measured) const;
+  // update measured the whole pose (a detector's box), not a fit of the returns. With the
+  // returns (points), a scan is evidence of motion only if they moved with the velocity since
+  // the track's last returns (ReturnsMovedWith).
+  void TestMotion(Track* t, bool pose_measured, const PointSet* points) const;
   // The score term and the filter update of one hypothesis with m (nullptr: nothing measured);
   // true if the update was accepted.
   bool ApplyMeasurement(const CentreMeasurement* m, TrackHypothesis* h);

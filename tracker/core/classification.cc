@@ -5,6 +5,7 @@
 #include <Eigen/Cholesky>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -47,23 +48,38 @@ bool ReturnsMovedWith(const PointSet& now, const ReturnsSnapshot& before, const 
   // this search.
   const Eigen::Vector2d off = now.origin - before.origin;  // now's frame -> before's frame
   const std::size_t stride = MotionCheckStride(now.size());
-  double still = 0.0, moved = 0.0;  // [m] summed nearest distances
+  const std::size_t m = before.x.size();
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  // Nearest squared distances of each of before's returns to now's (in place / displaced).
+  std::array<double, kMotionCheckPoints> col_still, col_moved;
+  col_still.fill(kInf);
+  col_moved.fill(kInf);
+  double still = 0.0, moved = 0.0;  // [m] summed nearest distances, both ways
   for (std::size_t i = 0; i < now.size(); i += stride) {
     const double px = now.x[i] + off.x(), py = now.y[i] + off.y();
-    double best_still = std::numeric_limits<double>::infinity(), best_moved = best_still;
-    for (std::size_t k = 0; k < before.x.size(); ++k) {
+    double row_still = kInf, row_moved = kInf;
+    for (std::size_t k = 0; k < m; ++k) {
       const double dx = px - before.x[k], dy = py - before.y[k];
-      best_still = std::min(best_still, dx * dx + dy * dy);
+      const double s2 = dx * dx + dy * dy;
       const double ex = dx - d.x(), ey = dy - d.y();
-      best_moved = std::min(best_moved, ex * ex + ey * ey);
+      const double m2 = ex * ex + ey * ey;
+      row_still = std::min(row_still, s2);
+      row_moved = std::min(row_moved, m2);
+      col_still[k] = std::min(col_still[k], s2);
+      col_moved[k] = std::min(col_moved[k], m2);
     }
-    still += std::sqrt(best_still);
-    moved += std::sqrt(best_moved);
+    still += std::sqrt(row_still);
+    moved += std::sqrt(row_moved);
+  }
+  if (!std::isfinite(still)) return false;  // no returns now
+  for (std::size_t k = 0; k < m; ++k) {
+    still += std::sqrt(col_still[k]);
+    moved += std::sqrt(col_moved[k]);
   }
   return moved < still;
 }
 
-void Snapshot(const PointSet& points, ReturnsSnapshot* out) {
+void SnapshotReturns(const PointSet& points, ReturnsSnapshot* out) {
   out->origin = points.origin;
   out->utime = points.mean_utime;
   out->x.clear();

@@ -2,6 +2,7 @@
 // (vehicle or other) from its estimated size and motion (track_manager.h describes both).
 #pragma once
 
+#include <cstddef>
 #include <limits>
 #include <optional>
 
@@ -30,26 +31,27 @@ class MoverTest {
   double min_speed_ = 0.0;    // [m/s]
 };
 
-// Whether a track's returns moved with its estimated velocity between two scans: the returns of
-// `now` lie nearer to those of `before` displaced by d (the velocity times the time between the
-// two scans) than to those of `before` where they were. The sum over now's returns of the
-// distance to the nearest of before's decides; at most kMotionCheckPoints evenly strided returns
-// of each take part.
+// Whether a track's returns moved with its estimated velocity between two scans: the two scans'
+// returns lie nearer to each other with `before` displaced by d (the velocity times the time
+// between the scans) than in place. The measure is the sum of each return's distance to the
+// nearest return of the other scan, both ways (a chamfer distance); at most kMotionCheckPoints
+// evenly strided returns of each scan take part, in the order the outline gives them.
 //
-// The filter's velocity also takes up a change of view: as more of a parked car comes into view,
-// the centre of its seen part moves along it and across it, and the returns of a bush or a
-// building corner change from scan to scan. Such returns lie where the last scan's lay: displaced
-// by d they fit worse, and the scan is no evidence of motion (MoverTest). The returns of a moving
-// object lie where its last returns went. Along a straight surface a displacement along it cannot
-// be told from none (the aperture problem of any matching of returns): a window sliding along a
-// wall passes the check.
+// The filter's velocity also takes up a change of view: the fitted centre of a partly seen parked
+// car moves as its fit changes, and the returns of a bush or a building corner change from scan
+// to scan. Returns that stayed where they were fit worse displaced, and the scan is no evidence
+// of motion (MoverTest). The returns of a moving object lie where its last returns went. Along a
+// single straight face a displacement along it cannot be told from none (the aperture problem of
+// any matching of returns), and a face that grows or a window that slides along a wall favours
+// the displacement: TrackManager tests only the velocity across a single fitted face, as the
+// mover test does.
 bool ReturnsMovedWith(const PointSet& now, const ReturnsSnapshot& before, const Eigen::Vector2d& d);
 
 // Keeps at most kMotionCheckPoints evenly strided returns of `points` for the next scan's check.
-void Snapshot(const PointSet& points, ReturnsSnapshot* out);
+void SnapshotReturns(const PointSet& points, ReturnsSnapshot* out);
 
 // [-] Returns per scan taking part in the motion check: bounds its cost to 64 x 64 distances per
-// tested track; 64 evenly strided returns of an outline still lie on every face it has.
+// tested track.
 constexpr std::size_t kMotionCheckPoints = 64;
 
 // The class of t. A track a detector's box measured: from its boxes (below). Otherwise, with

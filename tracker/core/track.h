@@ -61,7 +61,7 @@ struct Track {
   TrackStatus status = TrackStatus::kTentative;
   bool mover = false;
   int motion_evidence = 0;                // [-] consecutive scans with evidence of motion
-  ReturnsSnapshot last_returns;           // the returns of the last scan that measured it
+  ReturnsSnapshot last_returns;           // the returns of the last scan that gave it any
   std::int64_t created_utime = 0;         // [us]
   std::int64_t state_utime = 0;           // [us] time of the hypotheses' states
   std::int64_t last_update_utime = 0;     // [us]

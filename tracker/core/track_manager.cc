@@ -117,7 +117,7 @@ void TrackManager::Update(std::size_t index, const PointSet& points,
   }
   const bool any = UpdateHypotheses(points, sensor_xy, seed, tm, measurer, &t);
   AfterUpdate(any, tm, /*pose_measured=*/false, &points, &t);
-  Snapshot(points, &t.last_returns);
+  SnapshotReturns(points, &t.last_returns);
   if (any && !t.mover && !t.small_object && profile && !profile->empty()) {
     AlignToFullFace(ekf_, params_, points, sensor_xy, seed, *profile, measurer, &t);
   }
@@ -251,9 +251,15 @@ void TrackManager::TestMotion(Track* t, bool pose_measured, const PointSet* poin
   std::optional<bool> evidence = mover_test_.Evidence(ekf_, *t, pose_measured);
   if (!evidence) return;  // no evidence either way: the count is kept
   if (*evidence && points != nullptr && !t->last_returns.empty()) {
-    const CentreEstimate c = ekf_.Centre(t->hyps[static_cast<std::size_t>(t->selected)].filter);
+    const TrackHypothesis& sel = t->hyps[static_cast<std::size_t>(t->selected)];
+    Eigen::Vector2d v = ekf_.Centre(sel.filter).velocity;
+    if (sel.fit.kind == FitKind::kEdge) {
+      // As in the mover test, only the velocity across a single fitted face counts.
+      const Eigen::Vector2d n(-std::sin(sel.fit.phi), std::cos(sel.fit.phi));
+      v = n * n.dot(v);
+    }
     const double dt = static_cast<double>(points->mean_utime - t->last_returns.utime) * 1e-6;
-    evidence = ReturnsMovedWith(*points, t->last_returns, c.velocity * dt);
+    evidence = ReturnsMovedWith(*points, t->last_returns, v * dt);
   }
   t->motion_evidence = *evidence ? t->motion_evidence + 1 : 0;
   if (!t->mover && t->motion_evidence >= params_.mover_scans) {
@@ -409,7 +415,7 @@ bool TrackManager::Create(const PointSet& points, const Eigen::Vector2d& sensor_
   if (!m.z.allFinite() || !m.R.allFinite()) return false;
   StartFilter(m, &h);
   ObserveFirstShape(t.small_object, points, &h);
-  Snapshot(points, &t.last_returns);
+  SnapshotReturns(points, &t.last_returns);
   AddTrack(std::move(t), std::move(h), points.mean_utime);
   return true;
 }

@@ -181,7 +181,9 @@ class TrackManager {
   // The mover test on this scan, and what follows a mover declaration. pose_measured: the
   // update measured the whole pose (a detector's box), not a fit of the returns. With the
   // returns (points), a scan is evidence of motion only if they moved with the velocity since
-  // the track's last returns (ReturnsMovedWith).
+  // the track's last returns (ReturnsMovedWith; after a single-edge fit, the velocity across the
+  // edge). A scan that is no evidence restarts the count, and a mover's ISM is not turned to
+  // that scan's velocity.
   void TestMotion(Track* t, bool pose_measured, const PointSet* points) const;
   // The score term and the filter update of one hypothesis with m (nullptr: nothing measured);
   // true if the update was accepted.

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -369,6 +370,37 @@ TEST(ParkedTrackTest, GrownSmallObjectWhoseFitFailsStaysASmallObjectUntilOneFits
     s.Update(k, view(s.t, -5.5, -3.7));
   }
   ExpectTheRearViewsCarAsOneRectangle(s.m);
+}
+
+
+// A parked bus (12 x 2.5 m) passed by the ego: its rear face is seen whole and its side comes into
+// view 0.4 m more on every scan, so the fitted rectangle grows and its centre moves along the
+// side while every return stays where it was. The returns did not move: never a mover
+// (ReturnsMovedWith, in the mover test).
+TEST(ParkedTrackTest, AParkedBusWhoseSideComesIntoViewIsNoMover) {
+  Scans s;
+  auto bus = [&s](double side) {
+    PointSet p;
+    p.origin = Eigen::Vector2d(20.0, 5.0);
+    for (double y = 4.0; y <= 6.5 + 1e-9; y += 0.05) {  // rear face at x = 14
+      p.x.push_back(static_cast<float>(14.0 - 20.0));
+      p.y.push_back(static_cast<float>(y - 5.0));
+    }
+    for (double x = 14.1; x <= 14.0 + side + 1e-9; x += 0.1) {  // right side at y = 4
+      p.x.push_back(static_cast<float>(x - 20.0));
+      p.y.push_back(static_cast<float>(4.0 - 5.0));
+    }
+    p.mean_utime = s.t;
+    p.extent = std::hypot(side, 2.5);
+    return p;
+  };
+  ASSERT_TRUE(s.Create(bus(4.0)));
+  for (int k = 1; k <= 20; ++k) {
+    s.t += kStep;
+    s.Update(k, bus(std::min(12.0, 4.0 + 0.4 * k)));
+    ASSERT_EQ(s.m.tracks().size(), 1u);
+    EXPECT_FALSE(s.m.tracks()[0].mover) << "scan " << k;
+  }
 }
 
 }  // namespace

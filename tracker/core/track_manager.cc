@@ -190,8 +190,28 @@ bool TrackManager::UpdateHypothesis(const Track& t, bool parked, const PointSet&
       measurer->Measure(t.small_object, points, sensor_xy, seed, pose(2),
                         parked ? std::optional<Eigen::Vector2d>(pose.head<2>()) : std::nullopt,
                         h, &m);
-  if (ApplyMeasurement(measured ? &m : nullptr, h)) ObserveShape(t.small_object, points, time_s, h);
+  if (ApplyMeasurement(measured ? &m : nullptr, h) ||
+      (measured && RestartLostStill(t, points, m, h))) {
+    ObserveShape(t.small_object, points, time_s, h);
+  }
   return h->updated_this_scan;
+}
+
+bool TrackManager::RestartLostStill(const Track& t, const PointSet& points,
+                                    const CentreMeasurement& m, TrackHypothesis* h) const {
+  if (t.mover || t.hyps.size() != 1 || h->consecutive_misses < params_.fail_misses ||
+      t.last_returns.empty() || !m.z.allFinite()) {
+    return false;
+  }
+  const Hypothesis ism = ekf_.Convert(h->filter, ModelKind::kIsm, 0.0);
+  const double dt = static_cast<double>(points.mean_utime - t.last_returns.utime) * 1e-6;
+  if (ReturnsMovedWith(points, t.last_returns, Eigen::Vector2d(ism.x(1), ism.x(3)) * dt)) {
+    return false;
+  }
+  h->filter = ekf_.Convert(ekf_.InitIsm(m), h->filter.kind, 0.0);
+  h->consecutive_misses = 0;
+  h->updated_this_scan = true;
+  return true;
 }
 
 bool TrackManager::ApplyMeasurement(const CentreMeasurement* m, TrackHypothesis* h) {

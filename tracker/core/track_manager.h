@@ -49,6 +49,16 @@
 // model, same heading), keeps its own inside fraction and noise scale, copies the shape, and
 // starts with the reported hypothesis' score history.
 //
+// Restart of a lost still object. An object that is not a mover and has one hypothesis has no
+// other to re-seed it from: when the gate rejects its measurement in fail_misses consecutive
+// scans in which it had points, and those points did not move with the hypothesis' velocity
+// (ReturnsMovedWith against the previous scan's returns), the filter has lost an object that its
+// returns still show in place. The typical cause is a jump of the fitted centre as the view
+// changes (a single face turning into a corner puts the centre half a width elsewhere), which the
+// filter's velocity took up in part while the gate refused the rest. The hypothesis restarts
+// from the measurement, at rest (Ekf::InitIsm), keeping its shape. Returns that did move leave it
+// as it is: a moving object is not pulled onto a measurement its motion does not explain.
+//
 // Axis of a stationary object. A fitted face whose both ends are seen (RangeProfile: beyond each
 // end, nothing nearer), shorter than vehicle_min_length and not shorter by more than 0.5 m than
 // the shape estimate along it (then part of it is unseen) is a front or rear face: the
@@ -167,6 +177,9 @@ class TrackManager {
                         TrackMeasurer* measurer, TrackHypothesis* h);
   // The shape estimate's observations after an accepted update, and on creation.
   void ObserveShape(bool small, const PointSet& points, double time_s, TrackHypothesis* h) const;
+  // The restart of a lost still object (above); returns whether h was restarted from m.
+  bool RestartLostStill(const Track& t, const PointSet& points, const CentreMeasurement& m,
+                        TrackHypothesis* h) const;
   void ObserveFirstShape(bool small, const PointSet& points, TrackHypothesis* h) const;
   // After the hypotheses' updates at utime (any: one was accepted): counts, the reported
   // hypothesis, re-seeding, the mover test. points: the returns that measured it (nullptr: a

@@ -403,5 +403,53 @@ TEST(ParkedTrackTest, AParkedBusWhoseSideComesIntoViewIsNoMover) {
   }
 }
 
+// A parked truck (10 x 2.5 m, centre (20, 5), heading 0) first seen by its rear face alone, then
+// whole once what hid its side has gone. The rear face alone is taken for a side (it is longer
+// than a car's default width), so the track's rectangle lies across the truck with its centre
+// just behind the face; the first corner fit measures the true centre, 4 m away and turned by
+// 90 deg, far beyond the gate. No return moved: the lone hypothesis restarts from the
+// measurement after fail_misses rejected scans (TrackManager, "Restart of a lost still object")
+// and lies on the truck from then on, instead of staying where the face alone had put it.
+TEST(ParkedTrackTest, AParkedTruckWhoseSideIsRevealedIsFollowedByItsTrack) {
+  Scans s;
+  auto truck = [&s](bool side) {
+    PointSet p;
+    p.origin = Eigen::Vector2d(20.0, 5.0);
+    for (double y = 3.75; y <= 6.25 + 1e-9; y += 0.05) {  // rear face at x = 15
+      p.x.push_back(static_cast<float>(15.0 - 20.0));
+      p.y.push_back(static_cast<float>(y - 5.0));
+    }
+    for (double x = 15.1; side && x <= 25.0 + 1e-9; x += 0.1) {  // right side at y = 3.75
+      p.x.push_back(static_cast<float>(x - 20.0));
+      p.y.push_back(static_cast<float>(3.75 - 5.0));
+    }
+    p.mean_utime = s.t;
+    p.extent = side ? std::hypot(10.0, 2.5) : 2.5;
+    return p;
+  };
+  ASSERT_TRUE(s.Create(truck(false)));
+  int k = 1;
+  for (; k <= 20; ++k) {
+    s.t += kStep;
+    s.Update(k, truck(false));
+  }
+  ASSERT_EQ(s.m.tracks().size(), 1u);
+  ASSERT_FALSE(s.m.tracks()[0].mover);
+  ASSERT_EQ(s.m.tracks()[0].hyps.size(), 1u);
+  // The premise: the face alone put the centre near the face, 4 m or more from the truck's.
+  ASSERT_GT((s.m.Box(0).center - Eigen::Vector2d(20.0, 5.0)).norm(), 3.0);
+  for (int j = 0; j < 15; ++j, ++k) {
+    s.t += kStep;
+    s.Update(k, truck(true));
+    ASSERT_EQ(s.m.tracks().size(), 1u);
+    EXPECT_FALSE(s.m.tracks()[0].mover) << "scan " << k;
+  }
+  const OrientedBox box = s.m.Box(0);
+  EXPECT_NEAR(box.center.x(), 20.0, 0.5);
+  EXPECT_NEAR(box.center.y(), 5.0, 0.5);
+  EXPECT_NEAR(std::abs(std::cos(box.theta)), 1.0, 0.05) << "theta " << box.theta;
+  EXPECT_EQ(s.m.tracks()[0].hyps[0].consecutive_misses, 0);
+}
+
 }  // namespace
 }  // namespace vtrack

@@ -541,30 +541,48 @@ const char* ToString(FitFailure failure) {
   return "unknown";
 }
 
+namespace {
+
+// |p[(m + 1) % 3] - p[m]|^2 for m = 0, 1, 2: every distance the three hypotheses of a triple
+// use, once each (their norms: std::sqrt of these, as Eigen's norm()). A difference taken the
+// other way is its exact negation (rounding to nearest is symmetric): the same square.
+std::array<double, 3> SquaredSides(const Eigen::Vector2d& p0, const Eigen::Vector2d& p1,
+                                   const Eigen::Vector2d& p2) {
+  return {(p1 - p0).squaredNorm(), (p2 - p1).squaredNorm(), (p0 - p2).squaredNorm()};
+}
+
+// The corner from p_k's perpendicular foot on the line through p_i and p_j; len = |p_j - p_i|,
+// other = |p_k - p_i|.
+CornerHypothesis CornerHypothesisOf(const Eigen::Vector2d& pi, const Eigen::Vector2d& pj,
+                                    const Eigen::Vector2d& pk, double len, double other) {
+  CornerHypothesis h;
+  const Eigen::Vector2d d = pj - pi;
+  const double scale = std::max({len, other, 1e-300});
+  if (!(len > 1e-9 * scale)) return h;  // coincident pair
+  const Eigen::Vector2d u = d / len;
+  h.corner = pi + u * u.dot(pk - pi);
+  const Eigen::Vector2d b = pk - h.corner;
+  const double blen = b.norm();
+  if (!(blen > 1e-9 * scale)) return h;  // p_k on the line: collinear
+  h.dir_b = b / blen;
+  const double ti = u.dot(pi - h.corner), tj = u.dot(pj - h.corner);
+  h.a_both_ways = (ti > 0.0) != (tj > 0.0);
+  h.dir_a = (ti + tj > 0.0) ? u : Eigen::Vector2d(-u);
+  h.degenerate = false;
+  return h;
+}
+
+}  // namespace
+
 std::array<CornerHypothesis, 3> CornerHypothesesFromPoints(const Eigen::Vector2d& p0,
                                                            const Eigen::Vector2d& p1,
                                                            const Eigen::Vector2d& p2) {
   const std::array<const Eigen::Vector2d*, 3> p = {&p0, &p1, &p2};
+  const std::array<double, 3> sq = SquaredSides(p0, p1, p2);
+  const std::array<double, 3> side = {std::sqrt(sq[0]), std::sqrt(sq[1]), std::sqrt(sq[2])};
   std::array<CornerHypothesis, 3> out;
   for (int k = 0; k < 3; ++k) {
-    const Eigen::Vector2d& pi = *p[(k + 1) % 3];
-    const Eigen::Vector2d& pj = *p[(k + 2) % 3];
-    const Eigen::Vector2d& pk = *p[k];
-    CornerHypothesis& h = out[k];
-    const Eigen::Vector2d d = pj - pi;
-    const double len = d.norm();
-    const double scale = std::max({len, (pk - pi).norm(), 1e-300});
-    if (!(len > 1e-9 * scale)) continue;  // coincident pair
-    const Eigen::Vector2d u = d / len;
-    h.corner = pi + u * u.dot(pk - pi);
-    const Eigen::Vector2d b = pk - h.corner;
-    const double blen = b.norm();
-    if (!(blen > 1e-9 * scale)) continue;  // p_k on the line: collinear
-    h.dir_b = b / blen;
-    const double ti = u.dot(pi - h.corner), tj = u.dot(pj - h.corner);
-    h.a_both_ways = (ti > 0.0) != (tj > 0.0);
-    h.dir_a = (ti + tj > 0.0) ? u : Eigen::Vector2d(-u);
-    h.degenerate = false;
+    out[k] = CornerHypothesisOf(*p[(k + 1) % 3], *p[(k + 2) % 3], *p[k], side[(k + 1) % 3], side[k]);
   }
   return out;
 }
@@ -1048,11 +1066,15 @@ Model RansacCorner(const Context& ctx, const Subset& sub, const FitParams& P, do
     const int idx[3] = {pick(rng), pick(rng), pick(rng)};
     if (idx[0] == idx[1] || idx[1] == idx[2] || idx[0] == idx[2]) return;
     const Eigen::Vector2d q[3] = {sub.P(idx[0]), sub.P(idx[1]), sub.P(idx[2])};
-    const auto hyps = CornerHypothesesFromPoints(q[0], q[1], q[2]);
+    // CornerHypothesesFromPoints' hypotheses, each built only if its pair is far enough apart
+    // (the test does not depend on the hypothesis: the same ones are scored).
+    const std::array<double, 3> sq = SquaredSides(q[0], q[1], q[2]);
+    const std::array<double, 3> side = {std::sqrt(sq[0]), std::sqrt(sq[1]), std::sqrt(sq[2])};
     for (int k = 0; k < 3; ++k) {
-      const CornerHypothesis& h = hyps[k];
+      if (sq[(k + 1) % 3] < min_sep2) continue;  // |q_j - q_i|^2
+      const CornerHypothesis h =
+          CornerHypothesisOf(q[(k + 1) % 3], q[(k + 2) % 3], q[k], side[(k + 1) % 3], side[k]);
       if (h.degenerate || h.a_both_ways) continue;
-      if ((q[(k + 1) % 3] - q[(k + 2) % 3]).squaredNorm() < min_sep2) continue;
       if ((q[k] - h.corner).squaredNorm() < min_sep2) continue;
       if (!CornerVisible(h, ctx.sensor, slant)) continue;
       const Eigen::Vector2d u0 = Cross(h.dir_a, h.dir_b) > 0.0 ? h.dir_a : h.dir_b;

@@ -111,9 +111,16 @@ struct Context {
   double Threshold2(double var) const { return std::max(k2 * var, min_t2); }
 };
 
+// NoDivisionAbove: the classification and RANSAC's costs use a normalised squared residual
+// x / t (t > 0) only where it is below 1 (an inlier); 1 or more all count alike. x >= t gives
+// x / t >= 1 exactly (rounding is monotonic and 1 is a double), so there 1 stands in for the
+// quotient without a division: every comparison and sum comes out the same. (A NaN residual
+// fails x < t as it failed x / t < 1.)
+
 // Normalised squared residual of a point (local p, unit ray) against edge k of the model, or
-// +inf if the point is not eligible for that edge (behind a corner by more than the threshold).
-// *r receives the signed distance and *var its variance.
+// +inf if the point is not eligible for that edge (behind a corner by more than the threshold);
+// 1 where it would be 1 or more (NoDivisionAbove). *r receives the signed distance and *var its
+// variance.
 // u0, u1: the model's m.U0(), m.U1() (passed in: computed once per model, not per point).
 double EdgeError(const Context& ctx, const Model& m, const Eigen::Vector2d& u0,
                  const Eigen::Vector2d& u1, int k, const Eigen::Vector2d& p,
@@ -130,7 +137,8 @@ double EdgeError(const Context& ctx, const Model& m, const Eigen::Vector2d& u0,
     const double a = along.dot(v);
     if (a < 0.0 && a * a >= t2) return std::numeric_limits<double>::infinity();
   }
-  return (*r) * (*r) / t2;
+  const double r2 = (*r) * (*r);
+  return r2 < t2 ? r2 / t2 : 1.0;
 }
 
 // Internal labels: an inlier within the threshold of both corner edges (near the corner) is
@@ -1007,7 +1015,9 @@ Model RansacEdge(const Context& ctx, const Subset& sub, const FitParams& P, doub
     for (int s = 0; s < S && cost < *best_cost; ++s) {
       const double r = nrm.x() * (sub.x[s] - mid.x()) + nrm.y() * (sub.y[s] - mid.y());
       const double ca = nrm.x() * sub.rx[s] + nrm.y() * sub.ry[s];
-      const double e = r * r / ctx.Threshold2(ctx.PerpVar(ca));
+      // r^2 / t is only used below 1 (NoDivisionAbove).
+      const double r2 = r * r, t = ctx.Threshold2(ctx.PerpVar(ca));
+      const double e = r2 < t ? r2 / t : 1.0;
       if (e < 1.0) {
         cost += e;
         ++inliers;
@@ -1041,8 +1051,10 @@ double CornerCost(const Context& ctx, const Subset& sub, const Eigen::Vector2d& 
     const double a1 = u1.x() * vx + u1.y() * vy;  // along edge 1 = residual of edge 0
     const double t0 = ctx.Threshold2(ctx.PerpVar(u1.x() * sub.rx[s] + u1.y() * sub.ry[s]));
     const double t1 = ctx.Threshold2(ctx.PerpVar(u0.x() * sub.rx[s] + u0.y() * sub.ry[s]));
-    const double e0 = (a0 >= 0.0 || a0 * a0 < t0) ? a1 * a1 / t0 : 1.0;
-    const double e1 = (a1 >= 0.0 || a1 * a1 < t1) ? a0 * a0 / t1 : 1.0;
+    // e0 and e1 are only used below 1 (e0 <= e1 only once e0 < 1): NoDivisionAbove.
+    const double a0s = a0 * a0, a1s = a1 * a1;
+    const double e0 = (a0 >= 0.0 || a0s < t0) && a1s < t0 ? a1s / t0 : 1.0;
+    const double e1 = (a1 >= 0.0 || a1s < t1) && a0s < t1 ? a0s / t1 : 1.0;
     if (e0 < 1.0 && e0 <= e1) {
       cost += e0;
       ++*n0;

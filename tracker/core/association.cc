@@ -1,7 +1,9 @@
 #include "tracker/core/association.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numeric>
 #include <sstream>
@@ -182,6 +184,46 @@ inline Eigen::Vector2d InFrame(const Associator::RectFrame& f, double x, double 
   return {dx * f.ax + dy * f.ay, -dx * f.ay + dy * f.ax};
 }
 
+// Two doubles side by side (a GCC and Clang vector extension: one SSE2 register on x86-64, a
+// pair of scalars where there is none). Lane-wise operations round exactly as the scalar ones.
+typedef double Double2 __attribute__((vector_size(16)));
+typedef std::int64_t Mask2 __attribute__((vector_size(16)));  // a lane's comparison: 0 or -1
+inline Double2 Splat(double v) { return Double2{v, v}; }
+// std::max(a, b) (a < b ? b : a) and std::abs(a) (the sign bit cleared) lane by lane.
+inline Double2 Max2(Double2 a, Double2 b) { return a < b ? b : a; }
+inline Double2 Abs2(Double2 a) {
+  constexpr std::int64_t kAllButSign = std::numeric_limits<std::int64_t>::max();
+  return std::bit_cast<Double2>(std::bit_cast<Mask2>(a) & Mask2{kAllButSign, kAllButSign});
+}
+
+// For returns (x[k], y[k]), k < n (even), the signed distance d to the boundary of claimant c
+// (frame f; SplitAmong), kept with c in best_d[k], best[k] where d < best_d[k]. Two returns per
+// step, without branches: the same doubles and comparisons as one return at a time.
+void KeepNearer(const Associator::RectFrame& f, std::int64_t c, std::size_t n, const double* x,
+                const double* y, double* best_d, std::int64_t* best) {
+  const Double2 cx = Splat(f.cx), cy = Splat(f.cy), ax = Splat(f.ax), ay = Splat(f.ay);
+  const Double2 hl = Splat(f.hl), hw = Splat(f.hw), zero = Splat(0.0);
+  const Mask2 claimant = {c, c};
+  for (std::size_t k = 0; k < n; k += 2) {
+    Double2 px, py, old;
+    Mask2 old_best;
+    std::memcpy(&px, x + k, sizeof px);
+    std::memcpy(&py, y + k, sizeof py);
+    std::memcpy(&old, best_d + k, sizeof old);
+    std::memcpy(&old_best, best + k, sizeof old_best);
+    const Double2 dx = px - cx, dy = py - cy;  // InFrame
+    const Double2 qx = dx * ax + dy * ay, qy = -dx * ay + dy * ax;
+    const Double2 ex = Abs2(qx) - hl, ey = Abs2(qy) - hw;
+    const Double2 ox = Max2(ex, zero), oy = Max2(ey, zero);
+    const Double2 d = ((ex > zero) | (ey > zero)) ? ox * ox + oy * oy : Max2(ex, ey);
+    const Mask2 nearer = d < old;
+    const Double2 new_d = nearer ? d : old;
+    const Mask2 new_best = nearer ? claimant : old_best;
+    std::memcpy(best_d + k, &new_d, sizeof new_d);
+    std::memcpy(best + k, &new_best, sizeof new_best);
+  }
+}
+
 // Part buffers are kept from scan to scan, but not beyond twice what this scan's segments hold
 // (plus this many returns): otherwise every slot would keep the largest part it ever held (RSS
 // creeping up over a long run although nothing leaks).
@@ -239,25 +281,29 @@ void Associator::SplitAmong(const std::vector<PredictedObject>& tracks,
     claimants_.push_back({g.cx, g.cy, g.ax, g.ay, 0.5 * tracks[j].box.length,
                           0.5 * tracks[j].box.width});
   }
-  const RectFrame* const cl = claimants_.data();
-  const std::size_t nc = claimants_.size();
-  for (const std::int32_t* it = begin; it != end; ++it) {
-    const std::int32_t i = *it;
-    const auto iu = static_cast<std::size_t>(i);
-    const double px = pts.x[iu], py = pts.y[iu];
-    std::size_t best = 0;
-    double best_d = kInf;
-    for (std::size_t c = 0; c < nc; ++c) {
-      const Eigen::Vector2d q = InFrame(cl[c], px, py);
-      const double ex = std::abs(q.x()) - cl[c].hl, ey = std::abs(q.y()) - cl[c].hw;
-      const double ox = std::max(ex, 0.0), oy = std::max(ey, 0.0);
-      const double d = ex > 0.0 || ey > 0.0 ? ox * ox + oy * oy : std::max(ex, ey);
-      if (d < best_d) {
-        best_d = d;
-        best = c;
-      }
-    }
-    parts_[first + best].points.push_back(i);
+  // Claimant by claimant over the returns gathered side by side (an odd count padded with a
+  // copy of the last return, whose answer is not used): each return still meets the claimants
+  // in order and keeps the first of the nearest.
+  const auto n = static_cast<std::size_t>(end - begin);
+  const std::size_t padded = n + (n & 1);
+  split_x_.resize(padded);
+  split_y_.resize(padded);
+  split_d_.assign(padded, kInf);
+  split_best_.assign(padded, 0);
+  for (std::size_t k = 0; k < n; ++k) {
+    split_x_[k] = pts.x[static_cast<std::size_t>(begin[k])];
+    split_y_[k] = pts.y[static_cast<std::size_t>(begin[k])];
+  }
+  if (padded > n) {
+    split_x_[n] = split_x_[n - 1];
+    split_y_[n] = split_y_[n - 1];
+  }
+  for (std::size_t c = 0; c < claimants_.size(); ++c) {
+    KeepNearer(claimants_[c], static_cast<std::int64_t>(c), padded, split_x_.data(),
+               split_y_.data(), split_d_.data(), split_best_.data());
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    parts_[first + static_cast<std::size_t>(split_best_[k])].points.push_back(begin[k]);
   }
 }
 

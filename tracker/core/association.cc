@@ -1,7 +1,6 @@
 #include "tracker/core/association.h"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -9,6 +8,7 @@
 #include <sstream>
 
 #include "base/angle.h"
+#include "tracker/core/double2.h"
 
 namespace vtrack {
 namespace {
@@ -184,18 +184,6 @@ inline Eigen::Vector2d InFrame(const Associator::RectFrame& f, double x, double 
   return {dx * f.ax + dy * f.ay, -dx * f.ay + dy * f.ax};
 }
 
-// Two doubles side by side (a GCC and Clang vector extension: one SSE2 register on x86-64, a
-// pair of scalars where there is none). Lane-wise operations round exactly as the scalar ones.
-typedef double Double2 __attribute__((vector_size(16)));
-typedef std::int64_t Mask2 __attribute__((vector_size(16)));  // a lane's comparison: 0 or -1
-inline Double2 Splat(double v) { return Double2{v, v}; }
-// std::max(a, b) (a < b ? b : a) and std::abs(a) (the sign bit cleared) lane by lane.
-inline Double2 Max2(Double2 a, Double2 b) { return a < b ? b : a; }
-inline Double2 Abs2(Double2 a) {
-  constexpr std::int64_t kAllButSign = std::numeric_limits<std::int64_t>::max();
-  return std::bit_cast<Double2>(std::bit_cast<Mask2>(a) & Mask2{kAllButSign, kAllButSign});
-}
-
 // For returns (x[k], y[k]), k < n (even), the signed distance d to the boundary of claimant c
 // (frame f; SplitAmong), kept with c in best_d[k], best[k] where d < best_d[k]. Two returns per
 // step, without branches: the same doubles and comparisons as one return at a time.
@@ -205,11 +193,8 @@ void KeepNearer(const Associator::RectFrame& f, std::int64_t c, std::size_t n, c
   const Double2 hl = Splat(f.hl), hw = Splat(f.hw), zero = Splat(0.0);
   const Mask2 claimant = {c, c};
   for (std::size_t k = 0; k < n; k += 2) {
-    Double2 px, py, old;
+    const Double2 px = Load2(x + k), py = Load2(y + k), old = Load2(best_d + k);
     Mask2 old_best;
-    std::memcpy(&px, x + k, sizeof px);
-    std::memcpy(&py, y + k, sizeof py);
-    std::memcpy(&old, best_d + k, sizeof old);
     std::memcpy(&old_best, best + k, sizeof old_best);
     const Double2 dx = px - cx, dy = py - cy;  // InFrame
     const Double2 qx = dx * ax + dy * ay, qy = -dx * ay + dy * ax;

@@ -21,17 +21,24 @@ constexpr double kBoundsSlack = 1e-3;  // [m]
 // costliest loops of a KITTI scan: squares are compared instead (sqrt is monotonic, so
 // sqrt(min(a, b)) = min(sqrt(a), sqrt(b)) exactly) and std::hypot's care for overflow, needless
 // for distances in metres, is left out (exact when one term is 0, within one ulp otherwise).
-inline double Sq(double a, double b) { return a * a + b * b; }
-
-// Squared distance of a box-frame point to face f (a segment of the rectangle boundary).
-double FaceDistanceSq(const Eigen::Vector2d& q, Face f, double half_l, double half_w) {
-  switch (f) {
-    case Face::kFront: return Sq(q.x() - half_l, std::max(std::abs(q.y()) - half_w, 0.0));
-    case Face::kRear: return Sq(q.x() + half_l, std::max(std::abs(q.y()) - half_w, 0.0));
-    case Face::kLeft: return Sq(q.y() - half_w, std::max(std::abs(q.x()) - half_l, 0.0));
-    case Face::kRight: return Sq(q.y() + half_w, std::max(std::abs(q.x()) - half_l, 0.0));
+//
+// Squared distance of two box-frame points (qx, qy, lane by lane) to the nearest face in
+// visible (bit f: Face f, a segment of the rectangle boundary), +inf if none; the faces in
+// order, as std::min over them one point at a time.
+Double2 NearestFaceSq2(Double2 qx, Double2 qy, std::uint8_t visible, double half_l,
+                       double half_w) {
+  const Double2 hl = Splat(half_l), hw = Splat(half_w), zero = Splat(0.0);
+  const Double2 off_x = Max2(Abs2(qx) - hl, zero), off_y = Max2(Abs2(qy) - hw, zero);
+  const auto sq = [](Double2 a, Double2 b) { return a * a + b * b; };
+  static_assert(static_cast<int>(Face::kFront) == 0 && static_cast<int>(Face::kLeft) == 1 &&
+                static_cast<int>(Face::kRear) == 2 && static_cast<int>(Face::kRight) == 3);
+  const Double2 face[4] = {sq(qx - hl, off_y), sq(qy - hw, off_x), sq(qx + hl, off_y),
+                           sq(qy + hw, off_x)};
+  Double2 d2 = Splat(kInf);
+  for (int f = 0; f < 4; ++f) {
+    if (visible & (1u << f)) d2 = face[f] < d2 ? face[f] : d2;  // std::min(d2, face)
   }
-  return kInf;
+  return d2;
 }
 
 // OrientedBox::ToBoxFrame with cos/sin computed once per box, not per point.
@@ -156,19 +163,27 @@ double Associator::PairCost(const PredictedObject& t, double margin, std::uint8_
   std::size_t inside = 0, outside = 0;
   double dist_sum = 0.0;
   const BoxFrame frame(t.box);
-  for (const std::int32_t i : part.points) {
-    const auto iu = static_cast<std::size_t>(i);
-    const Eigen::Vector2d q = frame.To(pts.x[iu], pts.y[iu]);
-    if (std::abs(q.x()) > hl + margin || std::abs(q.y()) > hw + margin) {
-      if (++outside > max_outside) return kInf;
-      continue;
+  // Two returns per step (an odd last one twice, its second lane unused), then lane by lane in
+  // order: the same counts, early stop and sum as one return at a time.
+  const Double2 cx = Splat(frame.c.x()), cy = Splat(frame.c.y());
+  const Double2 ax = Splat(frame.ax), ay = Splat(frame.ay);
+  const Double2 gate_l = Splat(hl + margin), gate_w = Splat(hw + margin);
+  const std::int32_t* const idx = part.points.data();
+  for (std::size_t k = 0; k < n; k += 2) {
+    const auto i0 = static_cast<std::size_t>(idx[k]);
+    const auto i1 = static_cast<std::size_t>(idx[k + 1 < n ? k + 1 : k]);
+    const Double2 dx = Double2{pts.x[i0], pts.x[i1]} - cx, dy = Double2{pts.y[i0], pts.y[i1]} - cy;
+    const Double2 qx = dx * ax + dy * ay, qy = -dx * ay + dy * ax;  // BoxFrame::To
+    const Mask2 out = (Abs2(qx) > gate_l) | (Abs2(qy) > gate_w);
+    const Double2 d2 = NearestFaceSq2(qx, qy, visible, hl, hw);
+    for (std::size_t lane = 0; lane < 2 && k + lane < n; ++lane) {
+      if (out[lane]) {
+        if (++outside > max_outside) return kInf;
+        continue;
+      }
+      ++inside;
+      dist_sum += std::sqrt(d2[lane]);
     }
-    ++inside;
-    double d2 = kInf;
-    for (int f = 0; f < 4; ++f) {
-      if (visible & (1u << f)) d2 = std::min(d2, FaceDistanceSq(q, static_cast<Face>(f), hl, hw));
-    }
-    dist_sum += std::sqrt(d2);
   }
   const double frac = static_cast<double>(inside) / nd;
   *inside_fraction = frac;

@@ -255,14 +255,23 @@ void Associator::ClaimingTracks(const Segment& s, const WorldPoints& pts,
   // gate, in track order.
   claim->clear();
   sorted_.Overlapping(s.min, s.max, &candidates_);
+  const std::int32_t* const point = segments.point.data();
   for (const std::int32_t jj : candidates_) {
     const auto j = static_cast<std::size_t>(jj);
     const RectFrame& g = gates_[j];
-    int inside = 0;  // counted up to split_min_points: all the claim needs
-    for (std::int32_t k = s.begin; k < s.end && inside < params_.split_min_points; ++k) {
-      const auto i = static_cast<std::size_t>(segments.point[static_cast<std::size_t>(k)]);
-      const Eigen::Vector2d q = InFrame(g, pts.x[i], pts.y[i]);
-      if (std::abs(q.x()) <= g.hl && std::abs(q.y()) <= g.hw) ++inside;
+    const Double2 cx = Splat(g.cx), cy = Splat(g.cy), ax = Splat(g.ax), ay = Splat(g.ay);
+    const Double2 hl = Splat(g.hl), hw = Splat(g.hw);
+    // Counted up to split_min_points (all the claim needs), two returns per step (an odd last
+    // one twice, its second lane unused): lane by lane InFrame's doubles, the same count.
+    int inside = 0;
+    for (std::int32_t k = s.begin; k < s.end && inside < params_.split_min_points; k += 2) {
+      const auto i0 = static_cast<std::size_t>(point[k]);
+      const auto i1 = static_cast<std::size_t>(point[k + 1 < s.end ? k + 1 : k]);
+      const Double2 dx = Double2{pts.x[i0], pts.x[i1]} - cx;
+      const Double2 dy = Double2{pts.y[i0], pts.y[i1]} - cy;
+      const Mask2 in = (Abs2(dx * ax + dy * ay) <= hl) & (Abs2(-dx * ay + dy * ax) <= hw);
+      inside += in[0] ? 1 : 0;
+      if (k + 1 < s.end && inside < params_.split_min_points) inside += in[1] ? 1 : 0;
     }
     if (inside >= params_.split_min_points) claim->push_back(j);
   }

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "base/angle.h"
+#include "tracker/core/double2.h"
 
 namespace vtrack {
 namespace {
@@ -109,6 +110,11 @@ struct Context {
     return std::max(sigma2 * cos_a * cos_a + surface2, kMinPerpVar);
   }
   double Threshold2(double var) const { return std::max(k2 * var, min_t2); }
+  // Threshold2(PerpVar(cos_a)) of two cosines, lane by lane the same doubles.
+  Double2 PerpThreshold2(Double2 cos_a) const {
+    const Double2 var = Max2(Splat(sigma2) * cos_a * cos_a + Splat(surface2), Splat(kMinPerpVar));
+    return Max2(Splat(k2) * var, Splat(min_t2));
+  }
 };
 
 // NoDivisionAbove: the classification and RANSAC's costs use a normalised squared residual
@@ -993,6 +999,34 @@ Model AdaptiveRansac(int max_iterations, int min_iterations, TrySample&& try_sam
   return best;
 }
 
+// The truncated cost of the edge through mid with unit normal nrm over the subset, with its
+// inliers; or any value >= bound once the sum reaches bound (its terms are >= 0: the sample
+// cannot be the best, and the rest of the subset is not scored).
+double EdgeCost(const Context& ctx, const Subset& sub, const Eigen::Vector2d& mid,
+                const Eigen::Vector2d& nrm, double bound, int* inliers) {
+  double cost = 0.0;
+  // Two points per step (an odd last one twice, its second lane unused), lane by lane the same
+  // doubles as one at a time; then summed and stopped at the bound one by one.
+  const Double2 mx = Splat(mid.x()), my = Splat(mid.y()), nx = Splat(nrm.x()), ny = Splat(nrm.y());
+  for (int s = 0; s < sub.size && cost < bound; s += 2) {
+    const int s1 = s + 1 < sub.size ? s + 1 : s;
+    const Double2 r = nx * (Double2{sub.x[s], sub.x[s1]} - mx) + ny * (Double2{sub.y[s], sub.y[s1]} - my);
+    const Double2 ca = nx * Double2{sub.rx[s], sub.rx[s1]} + ny * Double2{sub.ry[s], sub.ry[s1]};
+    // r^2 / t is only used below 1 (NoDivisionAbove; both lanes divided at once).
+    const Double2 r2 = r * r, t = ctx.PerpThreshold2(ca);
+    const Double2 e = r2 < t ? r2 / t : Splat(1.0);
+    for (int lane = 0; lane < 2 && s + lane < sub.size && (lane == 0 || cost < bound); ++lane) {
+      if (e[lane] < 1.0) {
+        cost += e[lane];
+        ++*inliers;
+      } else {
+        cost += 1.0;
+      }
+    }
+  }
+  return cost;
+}
+
 // RANSAC for a straight edge (2 points): the truncated quadratic cost of Eq. (16) over the
 // subset; samples whose edge the sensor cannot see (Eq. 15) are skipped.
 Model RansacEdge(const Context& ctx, const Subset& sub, const FitParams& P, double slant,
@@ -1008,23 +1042,8 @@ Model RansacEdge(const Context& ctx, const Subset& sub, const FitParams& P, doub
     const Eigen::Vector2d u = d.normalized();
     const Eigen::Vector2d mid = 0.5 * (pi + pj);
     if (!EdgeVisible(mid, u, ctx.sensor, slant)) return;
-    const Eigen::Vector2d nrm = Perp(u);
-    double cost = 0.0;
     int inliers = 0;
-    // Terms are >= 0: once the sum reaches the best cost the sample cannot win.
-    for (int s = 0; s < S && cost < *best_cost; ++s) {
-      const double r = nrm.x() * (sub.x[s] - mid.x()) + nrm.y() * (sub.y[s] - mid.y());
-      const double ca = nrm.x() * sub.rx[s] + nrm.y() * sub.ry[s];
-      // r^2 / t is only used below 1 (NoDivisionAbove).
-      const double r2 = r * r, t = ctx.Threshold2(ctx.PerpVar(ca));
-      const double e = r2 < t ? r2 / t : 1.0;
-      if (e < 1.0) {
-        cost += e;
-        ++inliers;
-      } else {
-        cost += 1.0;
-      }
-    }
+    const double cost = EdgeCost(ctx, sub, mid, Perp(u), *best_cost, &inliers);
     if (cost < *best_cost) {
       *best_cost = cost;
       best->num_edges = 1;
@@ -1045,24 +1064,33 @@ double CornerCost(const Context& ctx, const Subset& sub, const Eigen::Vector2d& 
                   int* n1) {
   double cost = 0.0;
   *n0 = *n1 = 0;
-  for (int s = 0; s < sub.size && cost < bound; ++s) {
-    const double vx = sub.x[s] - corner.x(), vy = sub.y[s] - corner.y();
-    const double a0 = u0.x() * vx + u0.y() * vy;  // along edge 0 = residual of edge 1
-    const double a1 = u1.x() * vx + u1.y() * vy;  // along edge 1 = residual of edge 0
-    const double t0 = ctx.Threshold2(ctx.PerpVar(u1.x() * sub.rx[s] + u1.y() * sub.ry[s]));
-    const double t1 = ctx.Threshold2(ctx.PerpVar(u0.x() * sub.rx[s] + u0.y() * sub.ry[s]));
-    // e0 and e1 are only used below 1 (e0 <= e1 only once e0 < 1): NoDivisionAbove.
-    const double a0s = a0 * a0, a1s = a1 * a1;
-    const double e0 = (a0 >= 0.0 || a0s < t0) && a1s < t0 ? a1s / t0 : 1.0;
-    const double e1 = (a1 >= 0.0 || a1s < t1) && a0s < t1 ? a0s / t1 : 1.0;
-    if (e0 < 1.0 && e0 <= e1) {
-      cost += e0;
-      ++*n0;
-    } else if (e1 < 1.0) {
-      cost += e1;
-      ++*n1;
-    } else {
-      cost += 1.0;
+  // Two points per step (an odd last one twice, its second lane unused), lane by lane the same
+  // doubles as one at a time; then classified, summed and stopped at the bound one by one.
+  const Double2 cx = Splat(corner.x()), cy = Splat(corner.y()), zero = Splat(0.0), one = Splat(1.0);
+  const Double2 u0x = Splat(u0.x()), u0y = Splat(u0.y()), u1x = Splat(u1.x()), u1y = Splat(u1.y());
+  for (int s = 0; s < sub.size && cost < bound; s += 2) {
+    const int s1 = s + 1 < sub.size ? s + 1 : s;
+    const Double2 vx = Double2{sub.x[s], sub.x[s1]} - cx, vy = Double2{sub.y[s], sub.y[s1]} - cy;
+    const Double2 rx = {sub.rx[s], sub.rx[s1]}, ry = {sub.ry[s], sub.ry[s1]};
+    const Double2 a0 = u0x * vx + u0y * vy;  // along edge 0 = residual of edge 1
+    const Double2 a1 = u1x * vx + u1y * vy;  // along edge 1 = residual of edge 0
+    const Double2 t0 = ctx.PerpThreshold2(u1x * rx + u1y * ry);
+    const Double2 t1 = ctx.PerpThreshold2(u0x * rx + u0y * ry);
+    // e0 and e1 are only used below 1 (e0 <= e1 only once e0 < 1): NoDivisionAbove (both
+    // lanes divided at once; a quotient not chosen is not used).
+    const Double2 a0s = a0 * a0, a1s = a1 * a1;
+    const Double2 e0 = (((a0 >= zero) | (a0s < t0)) & (a1s < t0)) ? a1s / t0 : one;
+    const Double2 e1 = (((a1 >= zero) | (a1s < t1)) & (a0s < t1)) ? a0s / t1 : one;
+    for (int lane = 0; lane < 2 && s + lane < sub.size && (lane == 0 || cost < bound); ++lane) {
+      if (e0[lane] < 1.0 && e0[lane] <= e1[lane]) {
+        cost += e0[lane];
+        ++*n0;
+      } else if (e1[lane] < 1.0) {
+        cost += e1[lane];
+        ++*n1;
+      } else {
+        cost += 1.0;
+      }
     }
   }
   return cost;

@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numeric>
 #include <sstream>
 
 #include "base/angle.h"
+#include "tracker/core/double2.h"
 
 namespace vtrack {
 namespace {
@@ -19,17 +21,24 @@ constexpr double kBoundsSlack = 1e-3;  // [m]
 // costliest loops of a KITTI scan: squares are compared instead (sqrt is monotonic, so
 // sqrt(min(a, b)) = min(sqrt(a), sqrt(b)) exactly) and std::hypot's care for overflow, needless
 // for distances in metres, is left out (exact when one term is 0, within one ulp otherwise).
-inline double Sq(double a, double b) { return a * a + b * b; }
-
-// Squared distance of a box-frame point to face f (a segment of the rectangle boundary).
-double FaceDistanceSq(const Eigen::Vector2d& q, Face f, double half_l, double half_w) {
-  switch (f) {
-    case Face::kFront: return Sq(q.x() - half_l, std::max(std::abs(q.y()) - half_w, 0.0));
-    case Face::kRear: return Sq(q.x() + half_l, std::max(std::abs(q.y()) - half_w, 0.0));
-    case Face::kLeft: return Sq(q.y() - half_w, std::max(std::abs(q.x()) - half_l, 0.0));
-    case Face::kRight: return Sq(q.y() + half_w, std::max(std::abs(q.x()) - half_l, 0.0));
+//
+// Squared distance of two box-frame points (qx, qy, lane by lane) to the nearest face in
+// visible (bit f: Face f, a segment of the rectangle boundary), +inf if none; the faces in
+// order, as std::min over them one point at a time.
+Double2 NearestFaceSq2(Double2 qx, Double2 qy, std::uint8_t visible, double half_l,
+                       double half_w) {
+  const Double2 hl = Splat(half_l), hw = Splat(half_w), zero = Splat(0.0);
+  const Double2 off_x = Max2(Abs2(qx) - hl, zero), off_y = Max2(Abs2(qy) - hw, zero);
+  const auto sq = [](Double2 a, Double2 b) { return a * a + b * b; };
+  static_assert(static_cast<int>(Face::kFront) == 0 && static_cast<int>(Face::kLeft) == 1 &&
+                static_cast<int>(Face::kRear) == 2 && static_cast<int>(Face::kRight) == 3);
+  const Double2 face[4] = {sq(qx - hl, off_y), sq(qy - hw, off_x), sq(qx + hl, off_y),
+                           sq(qy + hw, off_x)};
+  Double2 d2 = Splat(kInf);
+  for (int f = 0; f < 4; ++f) {
+    if (visible & (1u << f)) d2 = face[f] < d2 ? face[f] : d2;  // std::min(d2, face)
   }
-  return kInf;
+  return d2;
 }
 
 // OrientedBox::ToBoxFrame with cos/sin computed once per box, not per point.
@@ -154,19 +163,27 @@ double Associator::PairCost(const PredictedObject& t, double margin, std::uint8_
   std::size_t inside = 0, outside = 0;
   double dist_sum = 0.0;
   const BoxFrame frame(t.box);
-  for (const std::int32_t i : part.points) {
-    const auto iu = static_cast<std::size_t>(i);
-    const Eigen::Vector2d q = frame.To(pts.x[iu], pts.y[iu]);
-    if (std::abs(q.x()) > hl + margin || std::abs(q.y()) > hw + margin) {
-      if (++outside > max_outside) return kInf;
-      continue;
+  // Two returns per step (an odd last one twice, its second lane unused), then lane by lane in
+  // order: the same counts, early stop and sum as one return at a time.
+  const Double2 cx = Splat(frame.c.x()), cy = Splat(frame.c.y());
+  const Double2 ax = Splat(frame.ax), ay = Splat(frame.ay);
+  const Double2 gate_l = Splat(hl + margin), gate_w = Splat(hw + margin);
+  const std::int32_t* const idx = part.points.data();
+  for (std::size_t k = 0; k < n; k += 2) {
+    const auto i0 = static_cast<std::size_t>(idx[k]);
+    const auto i1 = static_cast<std::size_t>(idx[k + 1 < n ? k + 1 : k]);
+    const Double2 dx = Double2{pts.x[i0], pts.x[i1]} - cx, dy = Double2{pts.y[i0], pts.y[i1]} - cy;
+    const Double2 qx = dx * ax + dy * ay, qy = -dx * ay + dy * ax;  // BoxFrame::To
+    const Mask2 out = (Abs2(qx) > gate_l) | (Abs2(qy) > gate_w);
+    const Double2 d2 = NearestFaceSq2(qx, qy, visible, hl, hw);
+    for (std::size_t lane = 0; lane < 2 && k + lane < n; ++lane) {
+      if (out[lane]) {
+        if (++outside > max_outside) return kInf;
+        continue;
+      }
+      ++inside;
+      dist_sum += std::sqrt(d2[lane]);
     }
-    ++inside;
-    double d2 = kInf;
-    for (int f = 0; f < 4; ++f) {
-      if (visible & (1u << f)) d2 = std::min(d2, FaceDistanceSq(q, static_cast<Face>(f), hl, hw));
-    }
-    dist_sum += std::sqrt(d2);
   }
   const double frac = static_cast<double>(inside) / nd;
   *inside_fraction = frac;
@@ -180,6 +197,31 @@ namespace {
 inline Eigen::Vector2d InFrame(const Associator::RectFrame& f, double x, double y) {
   const double dx = x - f.cx, dy = y - f.cy;
   return {dx * f.ax + dy * f.ay, -dx * f.ay + dy * f.ax};
+}
+
+// For returns (x[k], y[k]), k < n (even), the signed distance d to the boundary of claimant c
+// (frame f; SplitAmong), kept with c in best_d[k], best[k] where d < best_d[k]. Two returns per
+// step, without branches: the same doubles and comparisons as one return at a time.
+void KeepNearer(const Associator::RectFrame& f, std::int64_t c, std::size_t n, const double* x,
+                const double* y, double* best_d, std::int64_t* best) {
+  const Double2 cx = Splat(f.cx), cy = Splat(f.cy), ax = Splat(f.ax), ay = Splat(f.ay);
+  const Double2 hl = Splat(f.hl), hw = Splat(f.hw), zero = Splat(0.0);
+  const Mask2 claimant = {c, c};
+  for (std::size_t k = 0; k < n; k += 2) {
+    const Double2 px = Load2(x + k), py = Load2(y + k), old = Load2(best_d + k);
+    Mask2 old_best;
+    std::memcpy(&old_best, best + k, sizeof old_best);
+    const Double2 dx = px - cx, dy = py - cy;  // InFrame
+    const Double2 qx = dx * ax + dy * ay, qy = -dx * ay + dy * ax;
+    const Double2 ex = Abs2(qx) - hl, ey = Abs2(qy) - hw;
+    const Double2 ox = Max2(ex, zero), oy = Max2(ey, zero);
+    const Double2 d = ((ex > zero) | (ey > zero)) ? ox * ox + oy * oy : Max2(ex, ey);
+    const Mask2 nearer = d < old;
+    const Double2 new_d = nearer ? d : old;
+    const Mask2 new_best = nearer ? claimant : old_best;
+    std::memcpy(best_d + k, &new_d, sizeof new_d);
+    std::memcpy(best + k, &new_best, sizeof new_best);
+  }
 }
 
 // Part buffers are kept from scan to scan, but not beyond twice what this scan's segments hold
@@ -213,14 +255,23 @@ void Associator::ClaimingTracks(const Segment& s, const WorldPoints& pts,
   // gate, in track order.
   claim->clear();
   sorted_.Overlapping(s.min, s.max, &candidates_);
+  const std::int32_t* const point = segments.point.data();
   for (const std::int32_t jj : candidates_) {
     const auto j = static_cast<std::size_t>(jj);
     const RectFrame& g = gates_[j];
-    int inside = 0;  // counted up to split_min_points: all the claim needs
-    for (std::int32_t k = s.begin; k < s.end && inside < params_.split_min_points; ++k) {
-      const auto i = static_cast<std::size_t>(segments.point[static_cast<std::size_t>(k)]);
-      const Eigen::Vector2d q = InFrame(g, pts.x[i], pts.y[i]);
-      if (std::abs(q.x()) <= g.hl && std::abs(q.y()) <= g.hw) ++inside;
+    const Double2 cx = Splat(g.cx), cy = Splat(g.cy), ax = Splat(g.ax), ay = Splat(g.ay);
+    const Double2 hl = Splat(g.hl), hw = Splat(g.hw);
+    // Counted up to split_min_points (all the claim needs), two returns per step (an odd last
+    // one twice, its second lane unused): lane by lane InFrame's doubles, the same count.
+    int inside = 0;
+    for (std::int32_t k = s.begin; k < s.end && inside < params_.split_min_points; k += 2) {
+      const auto i0 = static_cast<std::size_t>(point[k]);
+      const auto i1 = static_cast<std::size_t>(point[k + 1 < s.end ? k + 1 : k]);
+      const Double2 dx = Double2{pts.x[i0], pts.x[i1]} - cx;
+      const Double2 dy = Double2{pts.y[i0], pts.y[i1]} - cy;
+      const Mask2 in = (Abs2(dx * ax + dy * ay) <= hl) & (Abs2(-dx * ay + dy * ax) <= hw);
+      inside += in[0] ? 1 : 0;
+      if (k + 1 < s.end && inside < params_.split_min_points) inside += in[1] ? 1 : 0;
     }
     if (inside >= params_.split_min_points) claim->push_back(j);
   }
@@ -239,25 +290,29 @@ void Associator::SplitAmong(const std::vector<PredictedObject>& tracks,
     claimants_.push_back({g.cx, g.cy, g.ax, g.ay, 0.5 * tracks[j].box.length,
                           0.5 * tracks[j].box.width});
   }
-  const RectFrame* const cl = claimants_.data();
-  const std::size_t nc = claimants_.size();
-  for (const std::int32_t* it = begin; it != end; ++it) {
-    const std::int32_t i = *it;
-    const auto iu = static_cast<std::size_t>(i);
-    const double px = pts.x[iu], py = pts.y[iu];
-    std::size_t best = 0;
-    double best_d = kInf;
-    for (std::size_t c = 0; c < nc; ++c) {
-      const Eigen::Vector2d q = InFrame(cl[c], px, py);
-      const double ex = std::abs(q.x()) - cl[c].hl, ey = std::abs(q.y()) - cl[c].hw;
-      const double ox = std::max(ex, 0.0), oy = std::max(ey, 0.0);
-      const double d = ex > 0.0 || ey > 0.0 ? ox * ox + oy * oy : std::max(ex, ey);
-      if (d < best_d) {
-        best_d = d;
-        best = c;
-      }
-    }
-    parts_[first + best].points.push_back(i);
+  // Claimant by claimant over the returns gathered side by side (an odd count padded with a
+  // copy of the last return, whose answer is not used): each return still meets the claimants
+  // in order and keeps the first of the nearest.
+  const auto n = static_cast<std::size_t>(end - begin);
+  const std::size_t padded = n + (n & 1);
+  split_x_.resize(padded);
+  split_y_.resize(padded);
+  split_d_.assign(padded, kInf);
+  split_best_.assign(padded, 0);
+  for (std::size_t k = 0; k < n; ++k) {
+    split_x_[k] = pts.x[static_cast<std::size_t>(begin[k])];
+    split_y_[k] = pts.y[static_cast<std::size_t>(begin[k])];
+  }
+  if (padded > n) {
+    split_x_[n] = split_x_[n - 1];
+    split_y_[n] = split_y_[n - 1];
+  }
+  for (std::size_t c = 0; c < claimants_.size(); ++c) {
+    KeepNearer(claimants_[c], static_cast<std::int64_t>(c), padded, split_x_.data(),
+               split_y_.data(), split_d_.data(), split_best_.data());
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    parts_[first + static_cast<std::size_t>(split_best_[k])].points.push_back(begin[k]);
   }
 }
 

@@ -166,6 +166,9 @@ class Associator {
   std::vector<std::int32_t> candidates_;
   std::vector<RectFrame> gates_;           // per track: frame, half sizes grown by its gate
   std::vector<RectFrame> claimants_;       // the tracks claiming one segment
+  std::vector<double> split_x_, split_y_;  // split: the segment's returns side by side
+  std::vector<double> split_d_;            // split: per return, its distance to the nearest claimant
+  std::vector<std::int64_t> split_best_;   // split: per return, that claimant
   std::vector<Pair> pairs_;
   std::vector<int> row_of_, col_of_;       // assignment: track -> row, part -> column
   std::vector<double> cost_;               // assignment: cost matrix, row-major

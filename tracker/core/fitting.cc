@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "base/angle.h"
+#include "tracker/core/double2.h"
 
 namespace vtrack {
 namespace {
@@ -109,11 +110,23 @@ struct Context {
     return std::max(sigma2 * cos_a * cos_a + surface2, kMinPerpVar);
   }
   double Threshold2(double var) const { return std::max(k2 * var, min_t2); }
+  // Threshold2(PerpVar(cos_a)) of two cosines, lane by lane the same doubles.
+  Double2 PerpThreshold2(Double2 cos_a) const {
+    const Double2 var = Max2(Splat(sigma2) * cos_a * cos_a + Splat(surface2), Splat(kMinPerpVar));
+    return Max2(Splat(k2) * var, Splat(min_t2));
+  }
 };
 
+// NoDivisionAbove: the classification and RANSAC's costs use a normalised squared residual
+// x / t (t > 0) only where it is below 1 (an inlier); 1 or more all count alike. x >= t gives
+// x / t >= 1 exactly (rounding is monotonic and 1 is a double), so there 1 stands in for the
+// quotient without a division: every comparison and sum comes out the same. (A NaN residual
+// fails x < t as it failed x / t < 1.)
+
 // Normalised squared residual of a point (local p, unit ray) against edge k of the model, or
-// +inf if the point is not eligible for that edge (behind a corner by more than the threshold).
-// *r receives the signed distance and *var its variance.
+// +inf if the point is not eligible for that edge (behind a corner by more than the threshold);
+// 1 where it would be 1 or more (NoDivisionAbove). *r receives the signed distance and *var its
+// variance.
 // u0, u1: the model's m.U0(), m.U1() (passed in: computed once per model, not per point).
 double EdgeError(const Context& ctx, const Model& m, const Eigen::Vector2d& u0,
                  const Eigen::Vector2d& u1, int k, const Eigen::Vector2d& p,
@@ -130,7 +143,8 @@ double EdgeError(const Context& ctx, const Model& m, const Eigen::Vector2d& u0,
     const double a = along.dot(v);
     if (a < 0.0 && a * a >= t2) return std::numeric_limits<double>::infinity();
   }
-  return (*r) * (*r) / t2;
+  const double r2 = (*r) * (*r);
+  return r2 < t2 ? r2 / t2 : 1.0;
 }
 
 // Internal labels: an inlier within the threshold of both corner edges (near the corner) is
@@ -541,30 +555,48 @@ const char* ToString(FitFailure failure) {
   return "unknown";
 }
 
+namespace {
+
+// |p[(m + 1) % 3] - p[m]|^2 for m = 0, 1, 2: every distance the three hypotheses of a triple
+// use, once each (their norms: std::sqrt of these, as Eigen's norm()). A difference taken the
+// other way is its exact negation (rounding to nearest is symmetric): the same square.
+std::array<double, 3> SquaredSides(const Eigen::Vector2d& p0, const Eigen::Vector2d& p1,
+                                   const Eigen::Vector2d& p2) {
+  return {(p1 - p0).squaredNorm(), (p2 - p1).squaredNorm(), (p0 - p2).squaredNorm()};
+}
+
+// The corner from p_k's perpendicular foot on the line through p_i and p_j; len = |p_j - p_i|,
+// other = |p_k - p_i|.
+CornerHypothesis CornerHypothesisOf(const Eigen::Vector2d& pi, const Eigen::Vector2d& pj,
+                                    const Eigen::Vector2d& pk, double len, double other) {
+  CornerHypothesis h;
+  const Eigen::Vector2d d = pj - pi;
+  const double scale = std::max({len, other, 1e-300});
+  if (!(len > 1e-9 * scale)) return h;  // coincident pair
+  const Eigen::Vector2d u = d / len;
+  h.corner = pi + u * u.dot(pk - pi);
+  const Eigen::Vector2d b = pk - h.corner;
+  const double blen = b.norm();
+  if (!(blen > 1e-9 * scale)) return h;  // p_k on the line: collinear
+  h.dir_b = b / blen;
+  const double ti = u.dot(pi - h.corner), tj = u.dot(pj - h.corner);
+  h.a_both_ways = (ti > 0.0) != (tj > 0.0);
+  h.dir_a = (ti + tj > 0.0) ? u : Eigen::Vector2d(-u);
+  h.degenerate = false;
+  return h;
+}
+
+}  // namespace
+
 std::array<CornerHypothesis, 3> CornerHypothesesFromPoints(const Eigen::Vector2d& p0,
                                                            const Eigen::Vector2d& p1,
                                                            const Eigen::Vector2d& p2) {
   const std::array<const Eigen::Vector2d*, 3> p = {&p0, &p1, &p2};
+  const std::array<double, 3> sq = SquaredSides(p0, p1, p2);
+  const std::array<double, 3> side = {std::sqrt(sq[0]), std::sqrt(sq[1]), std::sqrt(sq[2])};
   std::array<CornerHypothesis, 3> out;
   for (int k = 0; k < 3; ++k) {
-    const Eigen::Vector2d& pi = *p[(k + 1) % 3];
-    const Eigen::Vector2d& pj = *p[(k + 2) % 3];
-    const Eigen::Vector2d& pk = *p[k];
-    CornerHypothesis& h = out[k];
-    const Eigen::Vector2d d = pj - pi;
-    const double len = d.norm();
-    const double scale = std::max({len, (pk - pi).norm(), 1e-300});
-    if (!(len > 1e-9 * scale)) continue;  // coincident pair
-    const Eigen::Vector2d u = d / len;
-    h.corner = pi + u * u.dot(pk - pi);
-    const Eigen::Vector2d b = pk - h.corner;
-    const double blen = b.norm();
-    if (!(blen > 1e-9 * scale)) continue;  // p_k on the line: collinear
-    h.dir_b = b / blen;
-    const double ti = u.dot(pi - h.corner), tj = u.dot(pj - h.corner);
-    h.a_both_ways = (ti > 0.0) != (tj > 0.0);
-    h.dir_a = (ti + tj > 0.0) ? u : Eigen::Vector2d(-u);
-    h.degenerate = false;
+    out[k] = CornerHypothesisOf(*p[(k + 1) % 3], *p[(k + 2) % 3], *p[k], side[(k + 1) % 3], side[k]);
   }
   return out;
 }
@@ -967,6 +999,34 @@ Model AdaptiveRansac(int max_iterations, int min_iterations, TrySample&& try_sam
   return best;
 }
 
+// The truncated cost of the edge through mid with unit normal nrm over the subset, with its
+// inliers; or any value >= bound once the sum reaches bound (its terms are >= 0: the sample
+// cannot be the best, and the rest of the subset is not scored).
+double EdgeCost(const Context& ctx, const Subset& sub, const Eigen::Vector2d& mid,
+                const Eigen::Vector2d& nrm, double bound, int* inliers) {
+  double cost = 0.0;
+  // Two points per step (an odd last one twice, its second lane unused), lane by lane the same
+  // doubles as one at a time; then summed and stopped at the bound one by one.
+  const Double2 mx = Splat(mid.x()), my = Splat(mid.y()), nx = Splat(nrm.x()), ny = Splat(nrm.y());
+  for (int s = 0; s < sub.size && cost < bound; s += 2) {
+    const int s1 = s + 1 < sub.size ? s + 1 : s;
+    const Double2 r = nx * (Double2{sub.x[s], sub.x[s1]} - mx) + ny * (Double2{sub.y[s], sub.y[s1]} - my);
+    const Double2 ca = nx * Double2{sub.rx[s], sub.rx[s1]} + ny * Double2{sub.ry[s], sub.ry[s1]};
+    // r^2 / t is only used below 1 (NoDivisionAbove; both lanes divided at once).
+    const Double2 r2 = r * r, t = ctx.PerpThreshold2(ca);
+    const Double2 e = r2 < t ? r2 / t : Splat(1.0);
+    for (int lane = 0; lane < 2 && s + lane < sub.size && (lane == 0 || cost < bound); ++lane) {
+      if (e[lane] < 1.0) {
+        cost += e[lane];
+        ++*inliers;
+      } else {
+        cost += 1.0;
+      }
+    }
+  }
+  return cost;
+}
+
 // RANSAC for a straight edge (2 points): the truncated quadratic cost of Eq. (16) over the
 // subset; samples whose edge the sensor cannot see (Eq. 15) are skipped.
 Model RansacEdge(const Context& ctx, const Subset& sub, const FitParams& P, double slant,
@@ -982,21 +1042,8 @@ Model RansacEdge(const Context& ctx, const Subset& sub, const FitParams& P, doub
     const Eigen::Vector2d u = d.normalized();
     const Eigen::Vector2d mid = 0.5 * (pi + pj);
     if (!EdgeVisible(mid, u, ctx.sensor, slant)) return;
-    const Eigen::Vector2d nrm = Perp(u);
-    double cost = 0.0;
     int inliers = 0;
-    // Terms are >= 0: once the sum reaches the best cost the sample cannot win.
-    for (int s = 0; s < S && cost < *best_cost; ++s) {
-      const double r = nrm.x() * (sub.x[s] - mid.x()) + nrm.y() * (sub.y[s] - mid.y());
-      const double ca = nrm.x() * sub.rx[s] + nrm.y() * sub.ry[s];
-      const double e = r * r / ctx.Threshold2(ctx.PerpVar(ca));
-      if (e < 1.0) {
-        cost += e;
-        ++inliers;
-      } else {
-        cost += 1.0;
-      }
-    }
+    const double cost = EdgeCost(ctx, sub, mid, Perp(u), *best_cost, &inliers);
     if (cost < *best_cost) {
       *best_cost = cost;
       best->num_edges = 1;
@@ -1017,22 +1064,33 @@ double CornerCost(const Context& ctx, const Subset& sub, const Eigen::Vector2d& 
                   int* n1) {
   double cost = 0.0;
   *n0 = *n1 = 0;
-  for (int s = 0; s < sub.size && cost < bound; ++s) {
-    const double vx = sub.x[s] - corner.x(), vy = sub.y[s] - corner.y();
-    const double a0 = u0.x() * vx + u0.y() * vy;  // along edge 0 = residual of edge 1
-    const double a1 = u1.x() * vx + u1.y() * vy;  // along edge 1 = residual of edge 0
-    const double t0 = ctx.Threshold2(ctx.PerpVar(u1.x() * sub.rx[s] + u1.y() * sub.ry[s]));
-    const double t1 = ctx.Threshold2(ctx.PerpVar(u0.x() * sub.rx[s] + u0.y() * sub.ry[s]));
-    const double e0 = (a0 >= 0.0 || a0 * a0 < t0) ? a1 * a1 / t0 : 1.0;
-    const double e1 = (a1 >= 0.0 || a1 * a1 < t1) ? a0 * a0 / t1 : 1.0;
-    if (e0 < 1.0 && e0 <= e1) {
-      cost += e0;
-      ++*n0;
-    } else if (e1 < 1.0) {
-      cost += e1;
-      ++*n1;
-    } else {
-      cost += 1.0;
+  // Two points per step (an odd last one twice, its second lane unused), lane by lane the same
+  // doubles as one at a time; then classified, summed and stopped at the bound one by one.
+  const Double2 cx = Splat(corner.x()), cy = Splat(corner.y()), zero = Splat(0.0), one = Splat(1.0);
+  const Double2 u0x = Splat(u0.x()), u0y = Splat(u0.y()), u1x = Splat(u1.x()), u1y = Splat(u1.y());
+  for (int s = 0; s < sub.size && cost < bound; s += 2) {
+    const int s1 = s + 1 < sub.size ? s + 1 : s;
+    const Double2 vx = Double2{sub.x[s], sub.x[s1]} - cx, vy = Double2{sub.y[s], sub.y[s1]} - cy;
+    const Double2 rx = {sub.rx[s], sub.rx[s1]}, ry = {sub.ry[s], sub.ry[s1]};
+    const Double2 a0 = u0x * vx + u0y * vy;  // along edge 0 = residual of edge 1
+    const Double2 a1 = u1x * vx + u1y * vy;  // along edge 1 = residual of edge 0
+    const Double2 t0 = ctx.PerpThreshold2(u1x * rx + u1y * ry);
+    const Double2 t1 = ctx.PerpThreshold2(u0x * rx + u0y * ry);
+    // e0 and e1 are only used below 1 (e0 <= e1 only once e0 < 1): NoDivisionAbove (both
+    // lanes divided at once; a quotient not chosen is not used).
+    const Double2 a0s = a0 * a0, a1s = a1 * a1;
+    const Double2 e0 = (((a0 >= zero) | (a0s < t0)) & (a1s < t0)) ? a1s / t0 : one;
+    const Double2 e1 = (((a1 >= zero) | (a1s < t1)) & (a0s < t1)) ? a0s / t1 : one;
+    for (int lane = 0; lane < 2 && s + lane < sub.size && (lane == 0 || cost < bound); ++lane) {
+      if (e0[lane] < 1.0 && e0[lane] <= e1[lane]) {
+        cost += e0[lane];
+        ++*n0;
+      } else if (e1[lane] < 1.0) {
+        cost += e1[lane];
+        ++*n1;
+      } else {
+        cost += 1.0;
+      }
     }
   }
   return cost;
@@ -1048,11 +1106,15 @@ Model RansacCorner(const Context& ctx, const Subset& sub, const FitParams& P, do
     const int idx[3] = {pick(rng), pick(rng), pick(rng)};
     if (idx[0] == idx[1] || idx[1] == idx[2] || idx[0] == idx[2]) return;
     const Eigen::Vector2d q[3] = {sub.P(idx[0]), sub.P(idx[1]), sub.P(idx[2])};
-    const auto hyps = CornerHypothesesFromPoints(q[0], q[1], q[2]);
+    // CornerHypothesesFromPoints' hypotheses, each built only if its pair is far enough apart
+    // (the test does not depend on the hypothesis: the same ones are scored).
+    const std::array<double, 3> sq = SquaredSides(q[0], q[1], q[2]);
+    const std::array<double, 3> side = {std::sqrt(sq[0]), std::sqrt(sq[1]), std::sqrt(sq[2])};
     for (int k = 0; k < 3; ++k) {
-      const CornerHypothesis& h = hyps[k];
+      if (sq[(k + 1) % 3] < min_sep2) continue;  // |q_j - q_i|^2
+      const CornerHypothesis h =
+          CornerHypothesisOf(q[(k + 1) % 3], q[(k + 2) % 3], q[k], side[(k + 1) % 3], side[k]);
       if (h.degenerate || h.a_both_ways) continue;
-      if ((q[(k + 1) % 3] - q[(k + 2) % 3]).squaredNorm() < min_sep2) continue;
       if ((q[k] - h.corner).squaredNorm() < min_sep2) continue;
       if (!CornerVisible(h, ctx.sensor, slant)) continue;
       const Eigen::Vector2d u0 = Cross(h.dir_a, h.dir_b) > 0.0 ? h.dir_a : h.dir_b;

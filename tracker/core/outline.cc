@@ -97,11 +97,10 @@ void OutlineExtractor::SortByBin(const PointSet& ps, const Eigen::Vector2d& s,
     bin_hi = std::max(bin_hi, bin);
   }
   if (keys_.size() < 2) return;
-  // The keys are distinct (k is), so any correct sort gives std::sort's order. A segment's
-  // returns fill a few dozen neighbouring bins of a few returns each: a counting sort by bin
-  // (stable, so k ascending within a bin), then an insertion sort of each bin by key, costs
-  // about n steps instead of n log n comparisons. Returns beside or behind the sensor (bins
-  // far apart) take std::sort.
+  // A segment's returns fill a few dozen neighbouring bins: a counting sort by bin (stable, so
+  // k ascending within a bin) costs about n steps instead of n log n comparisons. Within a bin
+  // PickInBin orders only what it needs. Returns beside or behind the sensor (bins far apart)
+  // take std::sort (the keys are distinct, k is: sorted by key within their bins).
   const auto n = static_cast<std::int64_t>(keys_.size());
   if (bin_hi - bin_lo > 4 * n + 256) {
     std::sort(keys_.begin(), keys_.end());
@@ -114,19 +113,12 @@ void OutlineExtractor::SortByBin(const PointSet& ps, const Eigen::Vector2d& s,
   for (std::size_t k = 0; k < keys_.size(); ++k) {
     sorted_keys_[bin_end_[static_cast<std::size_t>(bins_[k] - bin_lo)]++] = keys_[k];
   }
-  // bin_end_[i] is now the end of bin i and the start of bin i + 1.
-  std::size_t begin = 0;
-  for (std::size_t i = 0; i + 1 < bin_end_.size(); ++i) {
-    const std::size_t end = bin_end_[i];
-    SortBin(begin, end);
-    begin = end;
-  }
   keys_.swap(sorted_keys_);
 }
 
 void OutlineExtractor::SortBin(std::size_t begin, std::size_t end) {
   constexpr std::size_t kInsertionMax = 24;  // longer bins: std::sort (n^2 / 4 moves)
-  auto* a = sorted_keys_.data();
+  auto* a = keys_.data();
   if (end - begin > kInsertionMax) {
     std::sort(a + begin, a + end);
     return;
@@ -146,31 +138,11 @@ double OutlineExtractor::RangeOf(std::size_t a) const {
 
 void OutlineExtractor::PickPerBin(const WorldPoints& points, const std::vector<std::int32_t>& idx,
                                   const PointSet& ps, double support_h) {
-  const double support_r = params_.support_range;
-  auto height = [&](std::size_t a) {
-    return points.height[static_cast<std::size_t>(idx[static_cast<std::size_t>(keys_[a].second)])];
-  };
   std::size_t k = 0;
   while (k < keys_.size()) {
     std::size_t end = k + 1;
     while (end < keys_.size() && BinOf(keys_[end].first) == BinOf(keys_[k].first)) ++end;
-    std::size_t pick = k;
-    if (support_h > 0.0) {
-      pick = end;
-      for (std::size_t a = k; a < end && pick == end; ++a) {
-        const double ra = RangeOf(a);
-        const float ha = height(a);
-        for (std::size_t b = k; b < end; ++b) {
-          if (b == a) continue;
-          const double rb = RangeOf(b);
-          if (rb > ra + support_r) break;  // sorted by range
-          if (std::abs(rb - ra) <= support_r && std::abs(height(b) - ha) >= support_h) {
-            pick = a;
-            break;
-          }
-        }
-      }
-    }
+    const std::size_t pick = PickInBin(points, idx, k, end, support_h);
     if (pick < end) {
       const auto src = static_cast<std::size_t>(keys_[pick].second);
       outline_x_.push_back(ps.x[src]);
@@ -178,6 +150,44 @@ void OutlineExtractor::PickPerBin(const WorldPoints& points, const std::vector<s
     }
     k = end;
   }
+}
+
+std::size_t OutlineExtractor::PickInBin(const WorldPoints& points,
+                                        const std::vector<std::int32_t>& idx, std::size_t begin,
+                                        std::size_t end, double support_h) {
+  // The least (key, k) first: the nearest return, which most bins of a face pick. Only a bin
+  // whose nearest return has no support is sorted, to try the others nearest first.
+  std::size_t least = begin;
+  for (std::size_t a = begin + 1; a < end; ++a) {
+    if (keys_[a] < keys_[least]) least = a;
+  }
+  if (!(support_h > 0.0)) return least;
+  if (HasSupport(points, idx, begin, end, least, support_h)) return least;
+  SortBin(begin, end);  // keys_[begin] is now the least, which has no support
+  for (std::size_t a = begin + 1; a < end; ++a) {
+    if (HasSupport(points, idx, begin, end, a, support_h)) return a;
+  }
+  return end;
+}
+
+bool OutlineExtractor::HasSupport(const WorldPoints& points, const std::vector<std::int32_t>& idx,
+                                  std::size_t begin, std::size_t end, std::size_t a,
+                                  double support_h) const {
+  auto height = [&](std::size_t e) {
+    return points.height[static_cast<std::size_t>(idx[static_cast<std::size_t>(keys_[e].second)])];
+  };
+  const double support_r = params_.support_range;
+  const double ra = RangeOf(a);
+  const float ha = height(a);
+  for (std::size_t b = begin; b < end; ++b) {
+    if (b == a) continue;
+    const double rb = RangeOf(b);
+    // Beyond ra + support_r: not tested. (Ranges grow with the key: in key order this was where
+    // the search stopped, so the same entries are tested in any order.)
+    if (rb > ra + support_r) continue;
+    if (std::abs(rb - ra) <= support_r && std::abs(height(b) - ha) >= support_h) return true;
+  }
+  return false;
 }
 
 double OutlineExtractor::LongestRingSpan(const WorldPoints& points,

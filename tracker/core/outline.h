@@ -46,15 +46,23 @@ class OutlineExtractor {
   void Gather(const WorldPoints& points, const std::vector<std::int32_t>& idx,
               const LadarScan& scan, PointSet* out, Eigen::Vector2d* lo,
               Eigen::Vector2d* hi) const;
-  // Sorts the returns by bearing bin, then range, into keys_.
+  // Groups the returns by bearing bin into keys_: bins ascending, a bin's returns in k order
+  // (or by key).
   void SortByBin(const PointSet& ps, const Eigen::Vector2d& sensor, const Eigen::Vector2d& ref,
                  double bin_rad);
-  // Sorts sorted_keys_[begin, end), in k order, by key.
+  // Sorts keys_[begin, end), in k order, by key.
   void SortBin(std::size_t begin, std::size_t end);
   // Appends to outline_x_/y_ per bin the nearest return with support (support_height > 0), or
   // the nearest return (support_height 0).
   void PickPerBin(const WorldPoints& points, const std::vector<std::int32_t>& idx,
                   const PointSet& ps, double support_height);
+  // The entry of the bin keys_[begin, end) PickPerBin takes, or end if none.
+  std::size_t PickInBin(const WorldPoints& points, const std::vector<std::int32_t>& idx,
+                        std::size_t begin, std::size_t end, double support_height);
+  // Whether another return of the bin within support_range of keys_[a]'s range differs from its
+  // height by support_height or more.
+  bool HasSupport(const WorldPoints& points, const std::vector<std::int32_t>& idx,
+                  std::size_t begin, std::size_t end, std::size_t a, double support_height) const;
   // The largest range span of one ring's returns.
   double LongestRingSpan(const WorldPoints& points, const std::vector<std::int32_t>& idx);
   // Range [m] of keys_[a].

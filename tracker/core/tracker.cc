@@ -59,6 +59,8 @@ Tracker::Tracker(const TrackerParams& params, bool debug)
         UsesFeature(params_.evidence, three_d, EvidenceFeature::kHiddenEnds);
     roughness_used_[three_d ? 1 : 0] =
         UsesFeature(params_.evidence, three_d, EvidenceFeature::kRoughness);
+    column_top_used_[three_d ? 1 : 0] =
+        UsesFeature(params_.evidence, three_d, EvidenceFeature::kColumnTop);
   }
   for (int k = 0; k < params_.compute.threads; ++k) {
     workers_.emplace_back(params_.outline, manager_->NewMeasurer());
@@ -324,7 +326,8 @@ bool Tracker::ObserveEvidence(std::size_t index, const std::vector<std::int32_t>
       MeasureReturns(points_, idx, segment_of_, segment_extent_, sensor_xy, three_d, top_ring_,
                      record_evidence_ || hidden_ends_used_[three_d ? 1 : 0] ? &profile_ : nullptr,
                      &w->evidence_scratch,
-                     record_evidence_ || roughness_used_[three_d ? 1 : 0] ? &w->roughness_scratch : nullptr);
+                     record_evidence_ || roughness_used_[three_d ? 1 : 0] ? &w->roughness_scratch : nullptr,
+                     record_evidence_ || column_top_used_[three_d ? 1 : 0]);
   row->logit = manager_->ObserveEvidence(index, r, record_evidence_ ? &row->features : nullptr);
   if (!record_evidence_) return false;
   const Track& t = manager_->tracks()[index];

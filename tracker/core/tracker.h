@@ -173,11 +173,13 @@ class Tracker {
   std::vector<float> segment_extent_;     // [m] per segment: bounding-box diagonal
   int top_ring_ = -1;                     // TopRing of the scan being processed
   bool record_evidence_ = false;
-  // Whether the single-plane (0) and 3-D (1) evidence models use hidden_ends (roughness): only
-  // then (or when recording) are a track's ends looked up in the profile (its returns ordered
-  // along their rings). Set once from the parameters.
+  // Whether the single-plane (0) and 3-D (1) evidence models use hidden_ends (roughness,
+  // column_top): only then (or when recording) are a track's ends looked up in the profile (its
+  // returns ordered along their rings, their columns' tops gathered). Set once from the
+  // parameters.
   bool hidden_ends_used_[2] = {false, false};
   bool roughness_used_[2] = {false, false};
+  bool column_top_used_[2] = {false, false};
   std::int64_t returns_processed_ = 0;
   std::int64_t seed_ = 1;  // SetSeed
 };

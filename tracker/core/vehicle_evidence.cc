@@ -123,9 +123,9 @@ double SurfaceRoughness(const WorldPoints& pts, const std::vector<std::int32_t>&
 
 namespace {
 
-// The height profile and column top of the returns idx of a 3-D cloud; heights: theirs, in
-// idx order (reused as a buffer).
-void MeasureHeights(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
+// The height profile and (column_top) column top of the returns idx of a 3-D cloud; heights:
+// theirs, in idx order (reused as a buffer).
+void MeasureHeights(const WorldPoints& pts, const std::vector<std::int32_t>& idx, bool column_top,
                     ReturnEvidence* r, std::vector<float>* heights) {
   auto& h = *heights;
   const auto half = static_cast<std::ptrdiff_t>(h.size() / 2);
@@ -134,6 +134,7 @@ void MeasureHeights(const WorldPoints& pts, const std::vector<std::int32_t>& idx
   r->height_max = *hi;
   std::nth_element(h.begin(), h.begin() + half, h.end());
   r->height_median = h[static_cast<std::size_t>(half)];
+  if (!column_top) return;  // left at 0: no model asks for it (a gather and a median saved)
   if (pts.column_top.size() == pts.size()) {
     h.clear();
     for (const std::int32_t i : idx) h.push_back(pts.column_top[static_cast<std::size_t>(i)]);
@@ -151,7 +152,7 @@ ReturnEvidence MeasureReturns(const WorldPoints& pts, const std::vector<std::int
                               const std::vector<float>& segment_extent,
                               const Eigen::Vector2d& sensor_xy, bool three_d, int top_ring,
                               const RangeProfile* profile, std::vector<float>* scratch,
-                              std::vector<RingReturn>* roughness) {
+                              std::vector<RingReturn>* roughness, bool column_top) {
   ReturnEvidence r;
   r.three_d = three_d;
   r.num_points = static_cast<int>(idx.size());
@@ -175,7 +176,7 @@ ReturnEvidence MeasureReturns(const WorldPoints& pts, const std::vector<std::int
   if (profile != nullptr && !profile->empty()) {
     r.hidden_ends = HiddenEnds(pts, idx, centroid, sensor_xy, *profile);
   }
-  if (three_d) MeasureHeights(pts, idx, &r, scratch);
+  if (three_d) MeasureHeights(pts, idx, column_top, &r, scratch);
   // After the heights: it reuses scratch.
   if (roughness != nullptr) {
     r.roughness = SurfaceRoughness(pts, idx, centroid, sensor_xy, three_d, roughness, scratch);

@@ -94,12 +94,14 @@ int TopRing(const LadarScan& scan);
 // scan; profile: the scan's range profile (null or empty: hidden_ends stays NaN). scratch:
 // reused buffer.
 // roughness: null leaves ReturnEvidence::roughness NaN (not measured), else its scratch buffer.
+// column_top: false leaves ReturnEvidence::column_top 0 (not measured: a model without it).
 ReturnEvidence MeasureReturns(const WorldPoints& pts, const std::vector<std::int32_t>& idx,
                               const std::vector<std::int32_t>& segment_of,
                               const std::vector<float>& segment_extent,
                               const Eigen::Vector2d& sensor_xy, bool three_d, int top_ring,
                               const RangeProfile* profile, std::vector<float>* scratch,
-                              std::vector<RingReturn>* roughness = nullptr);
+                              std::vector<RingReturn>* roughness = nullptr,
+                              bool column_top = true);
 
 // Of the returns idx (centroid: their mean), the ends (extreme bearings from sensor_xy) that
 // are not free in profile (RangeProfile::FreeBeyond): 0, 1 or 2; 2 if they span no bearing.

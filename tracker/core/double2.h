@@ -2,7 +2,10 @@
 // vector extension (one SSE2 register on x86-64; a pair of scalars on a target without one).
 // Lane-wise +, -, *, / and comparisons round exactly as the scalar operations, and the helpers
 // below give exactly the scalar functions' results, so such a loop computes the very doubles a
-// loop over one return at a time would: no decision changes.
+// loop over one return at a time would: no decision changes. Eigen::Array2d does the same
+// arithmetic, but its abs, max and masked select go through expression templates whose
+// instruction sequence is not spelled out; here each operation is one that rounds as the scalar
+// code does, which is what the exactness rests on.
 #pragma once
 
 #include <bit>

@@ -373,27 +373,33 @@ TEST(ParkedTrackTest, GrownSmallObjectWhoseFitFailsStaysASmallObjectUntilOneFits
 }
 
 
+// Returns of a vehicle parked beside the origin (20, 5), heading 0, relative to that origin: its
+// rear face at x = rear_x from y = right_y to right_y + width (every 5 cm), and the first `side`
+// metres of its right side at y = right_y (every 10 cm; none for side 0).
+PointSet RearAndRightSide(std::int64_t utime, double rear_x, double right_y, double width,
+                          double side) {
+  PointSet p;
+  p.origin = Eigen::Vector2d(20.0, 5.0);
+  for (double y = right_y; y <= right_y + width + 1e-9; y += 0.05) {
+    p.x.push_back(static_cast<float>(rear_x - 20.0));
+    p.y.push_back(static_cast<float>(y - 5.0));
+  }
+  for (double x = rear_x + 0.1; x <= rear_x + side + 1e-9; x += 0.1) {
+    p.x.push_back(static_cast<float>(x - 20.0));
+    p.y.push_back(static_cast<float>(right_y - 5.0));
+  }
+  p.mean_utime = utime;
+  p.extent = std::hypot(side, width);
+  return p;
+}
+
 // A parked bus (12 x 2.5 m) passed by the ego: its rear face is seen whole and its side comes into
 // view 0.4 m more on every scan, so the fitted rectangle grows and its centre moves along the
 // side while every return stays where it was. The returns did not move: never a mover
 // (ReturnsMovedWith, in the mover test).
 TEST(ParkedTrackTest, AParkedBusWhoseSideComesIntoViewIsNoMover) {
   Scans s;
-  auto bus = [&s](double side) {
-    PointSet p;
-    p.origin = Eigen::Vector2d(20.0, 5.0);
-    for (double y = 4.0; y <= 6.5 + 1e-9; y += 0.05) {  // rear face at x = 14
-      p.x.push_back(static_cast<float>(14.0 - 20.0));
-      p.y.push_back(static_cast<float>(y - 5.0));
-    }
-    for (double x = 14.1; x <= 14.0 + side + 1e-9; x += 0.1) {  // right side at y = 4
-      p.x.push_back(static_cast<float>(x - 20.0));
-      p.y.push_back(static_cast<float>(4.0 - 5.0));
-    }
-    p.mean_utime = s.t;
-    p.extent = std::hypot(side, 2.5);
-    return p;
-  };
+  auto bus = [&s](double side) { return RearAndRightSide(s.t, 14.0, 4.0, 2.5, side); };
   ASSERT_TRUE(s.Create(bus(4.0)));
   for (int k = 1; k <= 20; ++k) {
     s.t += kStep;
@@ -412,21 +418,7 @@ TEST(ParkedTrackTest, AParkedBusWhoseSideComesIntoViewIsNoMover) {
 // and lies on the truck from then on, instead of staying where the face alone had put it.
 TEST(ParkedTrackTest, AParkedTruckWhoseSideIsRevealedIsFollowedByItsTrack) {
   Scans s;
-  auto truck = [&s](bool side) {
-    PointSet p;
-    p.origin = Eigen::Vector2d(20.0, 5.0);
-    for (double y = 3.75; y <= 6.25 + 1e-9; y += 0.05) {  // rear face at x = 15
-      p.x.push_back(static_cast<float>(15.0 - 20.0));
-      p.y.push_back(static_cast<float>(y - 5.0));
-    }
-    for (double x = 15.1; side && x <= 25.0 + 1e-9; x += 0.1) {  // right side at y = 3.75
-      p.x.push_back(static_cast<float>(x - 20.0));
-      p.y.push_back(static_cast<float>(3.75 - 5.0));
-    }
-    p.mean_utime = s.t;
-    p.extent = side ? std::hypot(10.0, 2.5) : 2.5;
-    return p;
-  };
+  auto truck = [&s](bool side) { return RearAndRightSide(s.t, 15.0, 3.75, 2.5, side ? 10.0 : 0.0); };
   ASSERT_TRUE(s.Create(truck(false)));
   int k = 1;
   for (; k <= 20; ++k) {

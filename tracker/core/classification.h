@@ -43,8 +43,8 @@ class MoverTest {
 // of motion (MoverTest). The returns of a moving object lie where its last returns went. Along a
 // single straight face a displacement along it cannot be told from none (the aperture problem of
 // any matching of returns), and a face that grows or a window that slides along a wall favours
-// the displacement: TrackManager tests only the velocity across a single fitted face, as the
-// mover test does.
+// the displacement: TrackManager's mover test tests only the velocity across a single fitted
+// face; the restart of a lost still object (track_manager.h) tests the whole velocity.
 bool ReturnsMovedWith(const PointSet& now, const ReturnsSnapshot& before, const Eigen::Vector2d& d);
 
 // Keeps at most kMotionCheckPoints evenly strided returns of `points` for the next scan's check.

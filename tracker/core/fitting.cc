@@ -1076,7 +1076,8 @@ double CornerCost(const Context& ctx, const Subset& sub, const Eigen::Vector2d& 
     const Double2 a1 = u1x * vx + u1y * vy;  // along edge 1 = residual of edge 0
     const Double2 t0 = ctx.PerpThreshold2(u1x * rx + u1y * ry);
     const Double2 t1 = ctx.PerpThreshold2(u0x * rx + u0y * ry);
-    // e0 and e1 are only used below 1 (e0 <= e1 only once e0 < 1): NoDivisionAbove (both
+    // e0 and e1 are only used below 1 (e0 <= e1 only once e0 < 1; for finite returns and rays,
+    // where neither is NaN): NoDivisionAbove (both
     // lanes divided at once; a quotient not chosen is not used).
     const Double2 a0s = a0 * a0, a1s = a1 * a1;
     const Double2 e0 = (((a0 >= zero) | (a0s < t0)) & (a1s < t0)) ? a1s / t0 : one;

@@ -211,6 +211,7 @@ bool TrackManager::RestartLostStill(const Track& t, const PointSet& points,
   h->filter = ekf_.Convert(ekf_.InitIsm(m), h->filter.kind, 0.0);
   h->consecutive_misses = 0;
   h->updated_this_scan = true;
+  h->last_nis = std::numeric_limits<double>::quiet_NaN();  // restarted, not an accepted update
   return true;
 }
 

@@ -50,14 +50,19 @@
 // starts with the reported hypothesis' score history.
 //
 // Restart of a lost still object. An object that is not a mover and has one hypothesis has no
-// other to re-seed it from: when the gate rejects its measurement in fail_misses consecutive
-// scans in which it had points, and those points did not move with the hypothesis' velocity
-// (ReturnsMovedWith against the previous scan's returns), the filter has lost an object that its
-// returns still show in place. The typical cause is a jump of the fitted centre as the view
-// changes (a single face turning into a corner puts the centre half a width elsewhere), which the
-// filter's velocity took up in part while the gate refused the rest. The hypothesis restarts
-// from the measurement, at rest (Ekf::InitIsm), keeping its shape. Returns that did move leave it
-// as it is: a moving object is not pulled onto a measurement its motion does not explain.
+// other to re-seed it from. When that hypothesis has had no accepted update in fail_misses
+// consecutive scans with returns, the gate has rejected this scan's measurement, and this scan's
+// returns did not move with the hypothesis' velocity (ReturnsMovedWith against the last scan's
+// returns, with the whole velocity: unlike the mover test, also its part along a single fitted
+// face), the filter has lost an object that its returns still show in place. The typical cause is
+// a jump of the fitted centre as the view changes (a single face turning into a corner puts the
+// centre half a width or more elsewhere), which the filter's velocity took up in part while the
+// gate refused the rest. The hypothesis restarts from the measurement, at rest (Ekf::InitIsm),
+// keeping its shape. Returns that moved with the velocity leave it as it is: a moving object is
+// not pulled onto a measurement its motion does not explain. A filter at rest cannot tell (zero
+// displacement is no evidence of motion): an object that has just started to move, before its
+// filter took up the motion, restarts at rest too. Small objects (measured by their centroid,
+// never movers) take the same path.
 //
 // Axis of a stationary object. A fitted face whose both ends are seen (RangeProfile: beyond each
 // end, nothing nearer), shorter than vehicle_min_length and not shorter by more than 0.5 m than

@@ -430,12 +430,17 @@ TEST(ParkedTrackTest, AParkedTruckWhoseSideIsRevealedIsFollowedByItsTrack) {
   ASSERT_EQ(s.m.tracks()[0].hyps.size(), 1u);
   // The premise: the face alone put the centre near the face, 4 m or more from the truck's.
   ASSERT_GT((s.m.Box(0).center - Eigen::Vector2d(20.0, 5.0)).norm(), 3.0);
+  int most_misses = 0;  // the hypothesis' consecutive misses before the restart
   for (int j = 0; j < 15; ++j, ++k) {
     s.t += kStep;
     s.Update(k, truck(true));
     ASSERT_EQ(s.m.tracks().size(), 1u);
     EXPECT_FALSE(s.m.tracks()[0].mover) << "scan " << k;
+    most_misses = std::max(most_misses, s.m.tracks()[0].hyps[0].consecutive_misses);
   }
+  // The gate refused the corner fits (the premise of the restart), fail_misses - 1 counted before
+  // the scan that restarted it.
+  EXPECT_EQ(most_misses, s.params.fail_misses - 1);
   const OrientedBox box = s.m.Box(0);
   EXPECT_NEAR(box.center.x(), 20.0, 0.5);
   EXPECT_NEAR(box.center.y(), 5.0, 0.5);

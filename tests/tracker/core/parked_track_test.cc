@@ -448,5 +448,41 @@ TEST(ParkedTrackTest, AParkedTruckWhoseSideIsRevealedIsFollowedByItsTrack) {
   EXPECT_EQ(s.m.tracks()[0].hyps[0].consecutive_misses, 0);
 }
 
+// The same view, of an 18 m articulated truck driving away at 5 m/s: its side is revealed at
+// scan 4, before six scans of evidence could make it a mover, and the gate refuses the corner
+// fits (the centre 7 m from the prediction, beyond even the gate the young filter's velocity
+// spread has grown; a 10 m truck's corner fit is accepted on the third scan). Its
+// returns moved with the filter's velocity, so it is no lost still object: it is not restarted
+// at rest (the filter keeps its velocity).
+TEST(ParkedTrackTest, AMovingTruckWhoseSideIsRevealedIsNotRestartedAtRest) {
+  Scans s;
+  constexpr double kSpeed = 5.0;  // [m/s] along x
+  const std::int64_t t0 = s.t;
+  auto truck = [&s, t0](bool side) {
+    const double rear_x = 15.0 + kSpeed * static_cast<double>(s.t - t0) * 1e-6;
+    return RearAndRightSide(s.t, rear_x, 3.75, 2.5, side ? 18.0 : 0.0);
+  };
+  ASSERT_TRUE(s.Create(truck(false)));
+  int k = 1;
+  for (; k <= 3; ++k) {
+    s.t += kStep;
+    s.Update(k, truck(false));
+  }
+  ASSERT_EQ(s.m.tracks().size(), 1u);
+  ASSERT_EQ(s.m.tracks()[0].hyps.size(), 1u);
+  // The premise: the filter has taken up the motion (the returns move with its velocity).
+  const Ekf ekf;
+  ASSERT_GT(ekf.Centre(s.m.tracks()[0].hyps[0].filter).speed, 3.0);
+  for (int j = 0; j < s.params.fail_misses; ++j, ++k) {
+    s.t += kStep;
+    s.Update(k, truck(true));
+    ASSERT_EQ(s.m.tracks().size(), 1u);
+    ASSERT_FALSE(s.m.tracks()[0].mover) << "scan " << k;
+  }
+  const TrackHypothesis& h = s.m.tracks()[0].hyps[0];
+  EXPECT_EQ(h.consecutive_misses, s.params.fail_misses);  // refused each time, not restarted
+  EXPECT_GT(ekf.Centre(h.filter).speed, 3.0);
+}
+
 }  // namespace
 }  // namespace vtrack

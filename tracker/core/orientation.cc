@@ -49,9 +49,11 @@ void AlignToShape(const Ekf& ekf, const TrackManagerParams& params, Track* t) {
   // A first fit of a partly seen object may take the wrong axis (a corner whose long side is
   // still hidden), and later fits keep the heading nearest the prediction. Not while the
   // "width" is shorter than any vehicle's length: a car's end face seen whole (1.8 m) beside the
-  // first metre of its side is not a side.
+  // first metre of its side is not a side. A VASM turns too (mode vasm): a still object's
+  // heading is only its axis, and one left across the object places every later fit's centre
+  // half the default length from the face it sees.
   for (auto& h : t->hyps) {
-    if (!HasIsmLayout(h.filter.kind) || !h.length_est || !h.width_est) continue;
+    if (!h.length_est || !h.width_est) continue;
     if (*h.width_est <= std::max(params.axis_swap_ratio * *h.length_est,
                                  params.vehicle_min_length)) {
       continue;

@@ -31,8 +31,8 @@ void AlignIsmToMotion(const Ekf& ekf, double ambiguity_deg, Track* t);
 void AlignVasmToMotion(Track* t);
 
 // A stationary object's length axis is its longer side: once the "width" estimate exceeds
-// axis_swap_ratio x the "length" and any vehicle's length (vehicle_min_length), the ISM
-// hypotheses turn by 90 deg.
+// axis_swap_ratio x the "length" and any vehicle's length (vehicle_min_length), its hypotheses
+// (ISM, CV or VASM) turn by 90 deg.
 void AlignToShape(const Ekf& ekf, const TrackManagerParams& params, Track* t);
 
 // A fitted face seen whole (free space or only farther returns just beyond both ends, in the

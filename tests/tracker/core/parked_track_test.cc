@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "base/angle.h"
@@ -37,8 +38,18 @@ PointSet ParkedCorner(std::int64_t utime) {
 
 constexpr std::int64_t kStep = 100'000;  // [us] 10 Hz
 
-// A track manager with the default parameters, the sensor at the origin, and the scans' clock.
+TrackManagerParams ParamsIn(TrackerMode mode) {
+  TrackManagerParams p;
+  p.mode = mode;
+  return p;
+}
+
+// A track manager with the default parameters (or those of a mode), the sensor at the origin,
+// and the scans' clock.
 struct Scans {
+  Scans() = default;
+  explicit Scans(TrackerMode mode) : params(ParamsIn(mode)) {}
+
   const Ekf ekf;
   const TrackManagerParams params{};
   TrackManager m{params, ekf, FitParams(), ShapeParams()};
@@ -416,8 +427,11 @@ TEST(ParkedTrackTest, AParkedBusWhoseSideComesIntoViewIsNoMover) {
 // 90 deg, far beyond the gate. No return moved: the lone hypothesis restarts from the
 // measurement after fail_misses rejected scans (TrackManager, "Restart of a lost still object")
 // and lies on the truck from then on, instead of staying where the face alone had put it.
-TEST(ParkedTrackTest, AParkedTruckWhoseSideIsRevealedIsFollowedByItsTrack) {
-  Scans s;
+// In every mode: the restart keeps the hypothesis' model kind (ISM, VASM or CV).
+class LostStillTest : public ::testing::TestWithParam<TrackerMode> {};
+
+TEST_P(LostStillTest, AParkedTruckWhoseSideIsRevealedIsFollowedByItsTrack) {
+  Scans s(GetParam());
   auto truck = [&s](bool side) { return RearAndRightSide(s.t, 15.0, 3.75, 2.5, side ? 10.0 : 0.0); };
   ASSERT_TRUE(s.Create(truck(false)));
   int k = 1;
@@ -446,6 +460,11 @@ TEST(ParkedTrackTest, AParkedTruckWhoseSideIsRevealedIsFollowedByItsTrack) {
   EXPECT_NEAR(box.center.y(), 5.0, 0.5);
   EXPECT_NEAR(std::abs(std::cos(box.theta)), 1.0, 0.05) << "theta " << box.theta;
   EXPECT_EQ(s.m.tracks()[0].hyps[0].consecutive_misses, 0);
+  // The mode's single model (mht: the ISM a still object is tracked with).
+  const ModelKind kind = GetParam() == TrackerMode::kVasm ? ModelKind::kVasm
+                         : GetParam() == TrackerMode::kCv ? ModelKind::kCv
+                                                          : ModelKind::kIsm;
+  EXPECT_EQ(s.m.tracks()[0].hyps[0].filter.kind, kind);
 }
 
 // The same view, of an 18 m articulated truck driving away at 5 m/s: its side is revealed at
@@ -453,9 +472,12 @@ TEST(ParkedTrackTest, AParkedTruckWhoseSideIsRevealedIsFollowedByItsTrack) {
 // fits (the centre 7 m from the prediction, beyond even the gate the young filter's velocity
 // spread has grown; a 10 m truck's corner fit is accepted on the third scan). Its
 // returns moved with the filter's velocity, so it is no lost still object: it is not restarted
-// at rest (the filter keeps its velocity).
-TEST(ParkedTrackTest, AMovingTruckWhoseSideIsRevealedIsNotRestartedAtRest) {
-  Scans s;
+// at rest (the filter keeps its velocity). Not in mode vasm: a VASM moves only along its heading,
+// which the rear face alone put across the motion, so its filter never takes up the motion.
+class MovingTruckTest : public ::testing::TestWithParam<TrackerMode> {};
+
+TEST_P(MovingTruckTest, AMovingTruckWhoseSideIsRevealedIsNotRestartedAtRest) {
+  Scans s(GetParam());
   constexpr double kSpeed = 5.0;  // [m/s] along x
   const std::int64_t t0 = s.t;
   auto truck = [&s, t0](bool side) {
@@ -483,6 +505,18 @@ TEST(ParkedTrackTest, AMovingTruckWhoseSideIsRevealedIsNotRestartedAtRest) {
   EXPECT_EQ(h.consecutive_misses, s.params.fail_misses);  // refused each time, not restarted
   EXPECT_GT(ekf.Centre(h.filter).speed, 3.0);
 }
+
+std::string ModeName(const ::testing::TestParamInfo<TrackerMode>& info) {
+  return NameOf(info.param);
+}
+
+INSTANTIATE_TEST_SUITE_P(Modes, LostStillTest,
+                         ::testing::Values(TrackerMode::kMht, TrackerMode::kIsm, TrackerMode::kVasm,
+                                           TrackerMode::kCv),
+                         ModeName);
+INSTANTIATE_TEST_SUITE_P(Modes, MovingTruckTest,
+                         ::testing::Values(TrackerMode::kMht, TrackerMode::kIsm, TrackerMode::kCv),
+                         ModeName);
 
 }  // namespace
 }  // namespace vtrack

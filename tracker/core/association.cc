@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "base/angle.h"
-#include "tracker/core/double2.h"
+#include "tracker/core/return_kernels.h"
 
 namespace vtrack {
 namespace {
@@ -16,30 +16,6 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // Slack on the bounds of a created rectangle, for the rounding of its corners.
 constexpr double kBoundsSlack = 1e-3;  // [m]
-
-// The per-return distances below are compared and summed once per return and track, the
-// costliest loops of a KITTI scan: squares are compared instead (sqrt is monotonic, so
-// sqrt(min(a, b)) = min(sqrt(a), sqrt(b)) exactly) and std::hypot's care for overflow, needless
-// for distances in metres, is left out (exact when one term is 0, within one ulp otherwise).
-//
-// Squared distance of two box-frame points (qx, qy, lane by lane) to the nearest face in
-// visible (bit f: Face f, a segment of the rectangle boundary), +inf if none; the faces in
-// order, as std::min over them one point at a time.
-Double2 NearestFaceSq2(Double2 qx, Double2 qy, std::uint8_t visible, double half_l,
-                       double half_w) {
-  const Double2 hl = Splat(half_l), hw = Splat(half_w), zero = Splat(0.0);
-  const Double2 off_x = Max2(Abs2(qx) - hl, zero), off_y = Max2(Abs2(qy) - hw, zero);
-  const auto sq = [](Double2 a, Double2 b) { return a * a + b * b; };
-  static_assert(static_cast<int>(Face::kFront) == 0 && static_cast<int>(Face::kLeft) == 1 &&
-                static_cast<int>(Face::kRear) == 2 && static_cast<int>(Face::kRight) == 3);
-  const Double2 face[4] = {sq(qx - hl, off_y), sq(qy - hw, off_x), sq(qx + hl, off_y),
-                           sq(qy + hw, off_x)};
-  Double2 d2 = Splat(kInf);
-  for (int f = 0; f < 4; ++f) {
-    if (visible & (1u << f)) d2 = face[f] < d2 ? face[f] : d2;  // std::min(d2, face)
-  }
-  return d2;
-}
 
 // OrientedBox::ToBoxFrame with cos/sin computed once per box, not per point.
 struct BoxFrame {
@@ -158,33 +134,15 @@ double Associator::PairCost(const PredictedObject& t, double margin, std::uint8_
   while (need > 1 && static_cast<double>(need - 1) / nd >= params_.min_inside_fraction) --need;
   while (need <= n && static_cast<double>(need) / nd < params_.min_inside_fraction) ++need;
   if (need > n) return kInf;
-  const std::size_t max_outside = n - need;
-  const double hl = 0.5 * t.box.length, hw = 0.5 * t.box.width;
-  std::size_t inside = 0, outside = 0;
-  double dist_sum = 0.0;
   const BoxFrame frame(t.box);
-  // Two returns per step (an odd last one twice, its second lane unused), then lane by lane in
-  // order: the same counts, early stop and sum as one return at a time.
-  const Double2 cx = Splat(frame.c.x()), cy = Splat(frame.c.y());
-  const Double2 ax = Splat(frame.ax), ay = Splat(frame.ay);
-  const Double2 gate_l = Splat(hl + margin), gate_w = Splat(hw + margin);
-  const std::int32_t* const idx = part.points.data();
-  for (std::size_t k = 0; k < n; k += 2) {
-    const auto i0 = static_cast<std::size_t>(idx[k]);
-    const auto i1 = static_cast<std::size_t>(idx[k + 1 < n ? k + 1 : k]);
-    const Double2 dx = Double2{pts.x[i0], pts.x[i1]} - cx, dy = Double2{pts.y[i0], pts.y[i1]} - cy;
-    const Double2 qx = dx * ax + dy * ay, qy = -dx * ay + dy * ax;  // BoxFrame::To
-    const Mask2 out = (Abs2(qx) > gate_l) | (Abs2(qy) > gate_w);
-    const Double2 d2 = NearestFaceSq2(qx, qy, visible, hl, hw);
-    for (std::size_t lane = 0; lane < 2 && k + lane < n; ++lane) {
-      if (out[lane]) {
-        if (++outside > max_outside) return kInf;
-        continue;
-      }
-      ++inside;
-      dist_sum += std::sqrt(d2[lane]);
-    }
-  }
+  const RectFrame box{frame.c.x(), frame.c.y(), frame.ax, frame.ay, 0.5 * t.box.length,
+                      0.5 * t.box.width};
+  const internal::GateSums sums = internal::SumGate(box, margin, visible, n - need,
+                                                    part.points.data(), n, pts.x.data(),
+                                                    pts.y.data());
+  if (sums.stopped) return kInf;
+  const std::size_t inside = sums.inside;
+  const double dist_sum = sums.dist_sum;
   const double frac = static_cast<double>(inside) / nd;
   *inside_fraction = frac;
   if (inside == 0 || frac < params_.min_inside_fraction) return kInf;
@@ -192,37 +150,6 @@ double Associator::PairCost(const PredictedObject& t, double margin, std::uint8_
 }
 
 namespace {
-
-// A return's coordinates in a rectangle's frame (as BoxFrame::To).
-inline Eigen::Vector2d InFrame(const Associator::RectFrame& f, double x, double y) {
-  const double dx = x - f.cx, dy = y - f.cy;
-  return {dx * f.ax + dy * f.ay, -dx * f.ay + dy * f.ax};
-}
-
-// For returns (x[k], y[k]), k < n (even), the signed distance d to the boundary of claimant c
-// (frame f; SplitAmong), kept with c in best_d[k], best[k] where d < best_d[k]. Two returns per
-// step, without branches: the same doubles and comparisons as one return at a time.
-void KeepNearer(const Associator::RectFrame& f, std::int64_t c, std::size_t n, const double* x,
-                const double* y, double* best_d, std::int64_t* best) {
-  const Double2 cx = Splat(f.cx), cy = Splat(f.cy), ax = Splat(f.ax), ay = Splat(f.ay);
-  const Double2 hl = Splat(f.hl), hw = Splat(f.hw), zero = Splat(0.0);
-  const Mask2 claimant = {c, c};
-  for (std::size_t k = 0; k < n; k += 2) {
-    const Double2 px = Load2(x + k), py = Load2(y + k), old = Load2(best_d + k);
-    Mask2 old_best;
-    std::memcpy(&old_best, best + k, sizeof old_best);
-    const Double2 dx = px - cx, dy = py - cy;  // InFrame
-    const Double2 qx = dx * ax + dy * ay, qy = -dx * ay + dy * ax;
-    const Double2 ex = Abs2(qx) - hl, ey = Abs2(qy) - hw;
-    const Double2 ox = Max2(ex, zero), oy = Max2(ey, zero);
-    const Double2 d = ((ex > zero) | (ey > zero)) ? ox * ox + oy * oy : Max2(ex, ey);
-    const Mask2 nearer = d < old;
-    const Double2 new_d = nearer ? d : old;
-    const Mask2 new_best = nearer ? claimant : old_best;
-    std::memcpy(best_d + k, &new_d, sizeof new_d);
-    std::memcpy(best + k, &new_best, sizeof new_best);
-  }
-}
 
 // Part buffers are kept from scan to scan, but not beyond twice what this scan's segments hold
 // (plus this many returns): otherwise every slot would keep the largest part it ever held (RSS
@@ -258,21 +185,10 @@ void Associator::ClaimingTracks(const Segment& s, const WorldPoints& pts,
   const std::int32_t* const point = segments.point.data();
   for (const std::int32_t jj : candidates_) {
     const auto j = static_cast<std::size_t>(jj);
-    const RectFrame& g = gates_[j];
-    const Double2 cx = Splat(g.cx), cy = Splat(g.cy), ax = Splat(g.ax), ay = Splat(g.ay);
-    const Double2 hl = Splat(g.hl), hw = Splat(g.hw);
-    // Counted up to split_min_points (all the claim needs), two returns per step (an odd last
-    // one twice, its second lane unused): lane by lane InFrame's doubles, the same count.
-    int inside = 0;
-    for (std::int32_t k = s.begin; k < s.end && inside < params_.split_min_points; k += 2) {
-      const auto i0 = static_cast<std::size_t>(point[k]);
-      const auto i1 = static_cast<std::size_t>(point[k + 1 < s.end ? k + 1 : k]);
-      const Double2 dx = Double2{pts.x[i0], pts.x[i1]} - cx;
-      const Double2 dy = Double2{pts.y[i0], pts.y[i1]} - cy;
-      const Mask2 in = (Abs2(dx * ax + dy * ay) <= hl) & (Abs2(-dx * ay + dy * ax) <= hw);
-      inside += in[0] ? 1 : 0;
-      if (k + 1 < s.end && inside < params_.split_min_points) inside += in[1] ? 1 : 0;
-    }
+    // Counted up to split_min_points (all the claim needs).
+    const int inside = internal::CountInside(gates_[j], point + s.begin,
+                                             static_cast<std::size_t>(s.end - s.begin),
+                                             pts.x.data(), pts.y.data(), params_.split_min_points);
     if (inside >= params_.split_min_points) claim->push_back(j);
   }
 }
@@ -308,8 +224,8 @@ void Associator::SplitAmong(const std::vector<PredictedObject>& tracks,
     split_y_[n] = split_y_[n - 1];
   }
   for (std::size_t c = 0; c < claimants_.size(); ++c) {
-    KeepNearer(claimants_[c], static_cast<std::int64_t>(c), padded, split_x_.data(),
-               split_y_.data(), split_d_.data(), split_best_.data());
+    internal::KeepNearer(claimants_[c], static_cast<std::int64_t>(c), padded, split_x_.data(),
+                         split_y_.data(), split_d_.data(), split_best_.data());
   }
   for (std::size_t k = 0; k < n; ++k) {
     parts_[first + static_cast<std::size_t>(split_best_[k])].points.push_back(begin[k]);

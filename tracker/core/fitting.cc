@@ -11,7 +11,7 @@
 #include <stdexcept>
 
 #include "base/angle.h"
-#include "tracker/core/double2.h"
+#include "tracker/core/return_kernels.h"
 
 namespace vtrack {
 namespace {
@@ -19,8 +19,7 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Gauss-Newton stops when a step moves the corner and phi by less than this [m, rad].
 constexpr double kConvergedStep = 1e-5;
-// Floor of a point's distance std [m]: keeps weights finite for a ray exactly along a face.
-constexpr double kMinPerpVar = 1e-3 * 1e-3;
+using internal::kMinPerpVar;
 
 double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   return a.x() * b.y() - a.y() * b.x();
@@ -83,8 +82,9 @@ struct EndOffset {
   double var = 0.0;
 };
 
-// The data and noise model of one fit.
-struct Context {
+// The data and noise model of one fit (the noise model's fields and two-lane threshold:
+// internal::PerpNoise).
+struct Context : internal::PerpNoise {
   // Per point, precomputed once per fit: local position and unit ray from the sensor.
   const double* px = nullptr;
   const double* py = nullptr;
@@ -93,10 +93,6 @@ struct Context {
   int n = 0;
   Eigen::Vector2d origin = Eigen::Vector2d::Zero();  // world position of the local frame
   Eigen::Vector2d sensor = Eigen::Vector2d::Zero();  // local
-  double sigma2 = 0.0;    // range variance
-  double surface2 = 0.0;  // surface variance
-  double k2 = 0.0;        // inlier_sigmas^2
-  double min_t2 = 0.0;    // squared threshold floor
 
   Eigen::Vector2d P(int i) const { return {px[i], py[i]}; }
   Eigen::Vector2d RayAt(int i) const { return {rx[i], ry[i]}; }
@@ -110,11 +106,6 @@ struct Context {
     return std::max(sigma2 * cos_a * cos_a + surface2, kMinPerpVar);
   }
   double Threshold2(double var) const { return std::max(k2 * var, min_t2); }
-  // Threshold2(PerpVar(cos_a)) of two cosines, lane by lane the same doubles.
-  Double2 PerpThreshold2(Double2 cos_a) const {
-    const Double2 var = Max2(Splat(sigma2) * cos_a * cos_a + Splat(surface2), Splat(kMinPerpVar));
-    return Max2(Splat(k2) * var, Splat(min_t2));
-  }
 };
 
 // NoDivisionAbove: the classification and RANSAC's costs use a normalised squared residual
@@ -954,13 +945,9 @@ FitFailure Measure(const Context& ctx, const FitRequest& req, const FitParams& p
   return FitFailure::kNone;
 }
 
-// The scoring subset of RANSAC: one point drawn from each of S equal strata of the point order
-// (local coordinates and ray directions).
-struct Subset {
-  const double *x, *y, *rx, *ry;
-  int size;
-  Eigen::Vector2d P(int i) const { return {x[i], y[i]}; }
-};
+// The scoring subset of RANSAC (internal::Subset): one point drawn from each of S equal strata
+// of the point order (local coordinates and ray directions).
+using internal::Subset;
 
 Subset DrawSubset(const Context& ctx, int max_points, std::minstd_rand& rng, std::vector<double>* sx,
                   std::vector<double>* sy, std::vector<double>* srx, std::vector<double>* sry) {
@@ -999,34 +986,6 @@ Model AdaptiveRansac(int max_iterations, int min_iterations, TrySample&& try_sam
   return best;
 }
 
-// The truncated cost of the edge through mid with unit normal nrm over the subset, with its
-// inliers; or any value >= bound once the sum reaches bound (its terms are >= 0: the sample
-// cannot be the best, and the rest of the subset is not scored).
-double EdgeCost(const Context& ctx, const Subset& sub, const Eigen::Vector2d& mid,
-                const Eigen::Vector2d& nrm, double bound, int* inliers) {
-  double cost = 0.0;
-  // Two points per step (an odd last one twice, its second lane unused), lane by lane the same
-  // doubles as one at a time; then summed and stopped at the bound one by one.
-  const Double2 mx = Splat(mid.x()), my = Splat(mid.y()), nx = Splat(nrm.x()), ny = Splat(nrm.y());
-  for (int s = 0; s < sub.size && cost < bound; s += 2) {
-    const int s1 = s + 1 < sub.size ? s + 1 : s;
-    const Double2 r = nx * (Double2{sub.x[s], sub.x[s1]} - mx) + ny * (Double2{sub.y[s], sub.y[s1]} - my);
-    const Double2 ca = nx * Double2{sub.rx[s], sub.rx[s1]} + ny * Double2{sub.ry[s], sub.ry[s1]};
-    // r^2 / t is only used below 1 (NoDivisionAbove; both lanes divided at once).
-    const Double2 r2 = r * r, t = ctx.PerpThreshold2(ca);
-    const Double2 e = r2 < t ? r2 / t : Splat(1.0);
-    for (int lane = 0; lane < 2 && s + lane < sub.size && (lane == 0 || cost < bound); ++lane) {
-      if (e[lane] < 1.0) {
-        cost += e[lane];
-        ++*inliers;
-      } else {
-        cost += 1.0;
-      }
-    }
-  }
-  return cost;
-}
-
 // RANSAC for a straight edge (2 points): the truncated quadratic cost of Eq. (16) over the
 // subset; samples whose edge the sensor cannot see (Eq. 15) are skipped.
 Model RansacEdge(const Context& ctx, const Subset& sub, const FitParams& P, double slant,
@@ -1043,7 +1002,7 @@ Model RansacEdge(const Context& ctx, const Subset& sub, const FitParams& P, doub
     const Eigen::Vector2d mid = 0.5 * (pi + pj);
     if (!EdgeVisible(mid, u, ctx.sensor, slant)) return;
     int inliers = 0;
-    const double cost = EdgeCost(ctx, sub, mid, Perp(u), *best_cost, &inliers);
+    const double cost = internal::EdgeCost(ctx, sub, mid, Perp(u), *best_cost, &inliers);
     if (cost < *best_cost) {
       *best_cost = cost;
       best->num_edges = 1;
@@ -1054,47 +1013,6 @@ Model RansacEdge(const Context& ctx, const Subset& sub, const FitParams& P, doub
     }
   };
   return AdaptiveRansac(P.max_edge_iterations, P.min_iterations, try_sample);
-}
-
-// The truncated cost of a corner over the subset, with the inliers of each edge; or any value
-// >= bound once the sum reaches bound (its terms are >= 0, so the full sum would too: the
-// sample cannot be the best, and the rest of the subset is not scored).
-double CornerCost(const Context& ctx, const Subset& sub, const Eigen::Vector2d& corner,
-                  const Eigen::Vector2d& u0, const Eigen::Vector2d& u1, double bound, int* n0,
-                  int* n1) {
-  double cost = 0.0;
-  *n0 = *n1 = 0;
-  // Two points per step (an odd last one twice, its second lane unused), lane by lane the same
-  // doubles as one at a time; then classified, summed and stopped at the bound one by one.
-  const Double2 cx = Splat(corner.x()), cy = Splat(corner.y()), zero = Splat(0.0), one = Splat(1.0);
-  const Double2 u0x = Splat(u0.x()), u0y = Splat(u0.y()), u1x = Splat(u1.x()), u1y = Splat(u1.y());
-  for (int s = 0; s < sub.size && cost < bound; s += 2) {
-    const int s1 = s + 1 < sub.size ? s + 1 : s;
-    const Double2 vx = Double2{sub.x[s], sub.x[s1]} - cx, vy = Double2{sub.y[s], sub.y[s1]} - cy;
-    const Double2 rx = {sub.rx[s], sub.rx[s1]}, ry = {sub.ry[s], sub.ry[s1]};
-    const Double2 a0 = u0x * vx + u0y * vy;  // along edge 0 = residual of edge 1
-    const Double2 a1 = u1x * vx + u1y * vy;  // along edge 1 = residual of edge 0
-    const Double2 t0 = ctx.PerpThreshold2(u1x * rx + u1y * ry);
-    const Double2 t1 = ctx.PerpThreshold2(u0x * rx + u0y * ry);
-    // e0 and e1 are only used below 1 (e0 <= e1 only once e0 < 1; for finite returns and rays,
-    // where neither is NaN): NoDivisionAbove (both
-    // lanes divided at once; a quotient not chosen is not used).
-    const Double2 a0s = a0 * a0, a1s = a1 * a1;
-    const Double2 e0 = (((a0 >= zero) | (a0s < t0)) & (a1s < t0)) ? a1s / t0 : one;
-    const Double2 e1 = (((a1 >= zero) | (a1s < t1)) & (a0s < t1)) ? a0s / t1 : one;
-    for (int lane = 0; lane < 2 && s + lane < sub.size && (lane == 0 || cost < bound); ++lane) {
-      if (e0[lane] < 1.0 && e0[lane] <= e1[lane]) {
-        cost += e0[lane];
-        ++*n0;
-      } else if (e1[lane] < 1.0) {
-        cost += e1[lane];
-        ++*n1;
-      } else {
-        cost += 1.0;
-      }
-    }
-  }
-  return cost;
 }
 
 // RANSAC for a corner (3 points, the three corners of Figure 3 each, filtered by Eq. 15).
@@ -1121,7 +1039,7 @@ Model RansacCorner(const Context& ctx, const Subset& sub, const FitParams& P, do
       const Eigen::Vector2d u0 = Cross(h.dir_a, h.dir_b) > 0.0 ? h.dir_a : h.dir_b;
       const Eigen::Vector2d u1 = Perp(u0);
       int n0 = 0, n1 = 0;
-      const double cost = CornerCost(ctx, sub, h.corner, u0, u1, *best_cost, &n0, &n1);
+      const double cost = internal::CornerCost(ctx, sub, h.corner, u0, u1, *best_cost, &n0, &n1);
       if (cost < *best_cost) {
         *best_cost = cost;
         best->num_edges = 2;

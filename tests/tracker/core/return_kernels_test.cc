@@ -1,0 +1,485 @@
+// The two-lane per-return loops of association and RANSAC (return_kernels.h) against loops over
+// one return at a time written here from the documented formulas: the nearest visible face of a
+// rectangle, the gate sums of the pair cost, the claim count, the nearest claimant of a split,
+// and RANSAC's truncated edge and corner costs. The loops claim the very doubles, counts and
+// early exits of the scalar code, so every result is compared exactly (EXPECT_EQ on doubles).
+//
+// Inputs are seeded random scenes: counts from 0 up, odd ones included (the last return then
+// fills both lanes, its second unused); quarter-metre grids with axis-aligned frames, on which
+// returns fall exactly on gates, faces and inlier thresholds and claimants tie exactly; any
+// heading and position otherwise, far from the origin and at extreme (finite) scales.
+//
+// The references keep the scalar code's order of operations within an expression (s * c * c is
+// (s * c) * c): another order rounds differently, and the claim is the same doubles, not close
+// ones. This file is compiled without floating-point contraction, as vtrack_core is.
+#include "tracker/core/return_kernels.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numeric>
+#include <random>
+#include <vector>
+
+#include "base/angle.h"
+#include "base/box.h"
+
+namespace vtrack::internal {
+namespace {
+
+using RectFrame = Associator::RectFrame;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr int kTrials = 3000;
+
+// ---- Scalar references
+
+struct BoxPoint {
+  double x, y;
+};
+
+// A world point in a rectangle's frame: the offset from its centre along and across its heading.
+BoxPoint InFrame(const RectFrame& f, double x, double y) {
+  const double dx = x - f.cx, dy = y - f.cy;
+  return {dx * f.ax + dy * f.ay, dy * f.ax - dx * f.ay};
+}
+BoxPoint InFrame(const RectFrame& f, const std::vector<double>& x, const std::vector<double>& y,
+                 std::int32_t i) {
+  return InFrame(f, x[static_cast<std::size_t>(i)], y[static_cast<std::size_t>(i)]);
+}
+
+// Squared distance of box-frame point q to face f of the rectangle [-hl, hl] x [-hw, hw], a
+// segment between two corners: front x = hl, left y = hw, rear x = -hl, right y = -hw.
+double FaceSq(BoxPoint q, Face f, double hl, double hw) {
+  const double beyond_x = q.x - std::clamp(q.x, -hl, hl);  // past the ends of a side face
+  const double beyond_y = q.y - std::clamp(q.y, -hw, hw);  // past the ends of an end face
+  switch (f) {
+    case Face::kFront: return (q.x - hl) * (q.x - hl) + beyond_y * beyond_y;
+    case Face::kLeft: return (q.y - hw) * (q.y - hw) + beyond_x * beyond_x;
+    case Face::kRear: return (q.x + hl) * (q.x + hl) + beyond_y * beyond_y;
+    case Face::kRight: return (q.y + hw) * (q.y + hw) + beyond_x * beyond_x;
+  }
+  return kInf;
+}
+
+// The nearest face in visible (bit f: Face f), squared; +inf if none.
+double NearestFaceSqRef(BoxPoint q, std::uint8_t visible, double hl, double hw) {
+  double d2 = kInf;
+  for (int f = 0; f < 4; ++f) {
+    if (visible & (1u << f)) d2 = std::min(d2, FaceSq(q, static_cast<Face>(f), hl, hw));
+  }
+  return d2;
+}
+
+// Associator::PairCost's sums: returns outside the gate (the rectangle grown by margin) counted
+// until more than max_outside; the distances to the nearest visible face of those inside summed.
+GateSums SumGateRef(const RectFrame& box, double margin, std::uint8_t visible,
+                    std::size_t max_outside, const std::vector<std::int32_t>& idx,
+                    const std::vector<double>& x, const std::vector<double>& y) {
+  GateSums s;
+  for (const std::int32_t i : idx) {
+    const BoxPoint q = InFrame(box, x, y, i);
+    if (std::abs(q.x) > box.hl + margin || std::abs(q.y) > box.hw + margin) {
+      s.stopped = ++s.outside > max_outside;
+      if (s.stopped) return s;
+      continue;
+    }
+    ++s.inside;
+    s.dist_sum += std::sqrt(NearestFaceSqRef(q, visible, box.hl, box.hw));
+  }
+  return s;
+}
+
+// Returns inside the gate (boundary included), counted in order until limit.
+int CountInsideRef(const RectFrame& gate, const std::vector<std::int32_t>& idx,
+                   const std::vector<double>& x, const std::vector<double>& y, int limit) {
+  int inside = 0;
+  for (const std::int32_t i : idx) {
+    if (inside >= limit) break;
+    const BoxPoint q = InFrame(gate, x, y, i);
+    if (std::abs(q.x) <= gate.hl && std::abs(q.y) <= gate.hw) ++inside;
+  }
+  return inside;
+}
+
+// Signed distance of a split: the squared distance to the rectangle outside it, minus the
+// distance to its nearest side inside (0 on the boundary).
+double SplitDistanceRef(const RectFrame& f, double x, double y) {
+  const BoxPoint q = InFrame(f, x, y);
+  const double ex = std::abs(q.x) - f.hl, ey = std::abs(q.y) - f.hw;
+  if (ex > 0.0 || ey > 0.0) {
+    const double ox = q.x - std::clamp(q.x, -f.hl, f.hl), oy = q.y - std::clamp(q.y, -f.hw, f.hw);
+    return ox * ox + oy * oy;
+  }
+  return std::max(ex, ey);
+}
+
+// The inlier threshold of a face whose normal makes cosine cos_a with the ray (fitting.cc:
+// Context::Threshold2(Context::PerpVar(cos_a))).
+double ThresholdRef(const PerpNoise& m, double cos_a) {
+  const double var = std::max(m.sigma2 * cos_a * cos_a + m.surface2, kMinPerpVar);
+  return std::max(m.k2 * var, m.min_t2);
+}
+
+// Eq. (16) truncated, point by point: r^2 / t below 1 (an inlier), else 1; the sum stops once it
+// reaches bound.
+double EdgeCostRef(const PerpNoise& m, const Subset& sub, const Eigen::Vector2d& mid,
+                   const Eigen::Vector2d& nrm, double bound, int* inliers) {
+  double cost = 0.0;
+  for (int s = 0; s < sub.size && cost < bound; ++s) {
+    const double r = nrm.x() * (sub.x[s] - mid.x()) + nrm.y() * (sub.y[s] - mid.y());
+    const double e = r * r / ThresholdRef(m, nrm.x() * sub.rx[s] + nrm.y() * sub.ry[s]);
+    if (e < 1.0) ++*inliers;
+    cost += e < 1.0 ? e : 1.0;
+  }
+  return cost;
+}
+
+// Points whose squared distance to the edge is exactly its inlier threshold.
+int OnThreshold(const PerpNoise& m, const Subset& sub, const Eigen::Vector2d& mid,
+                const Eigen::Vector2d& nrm) {
+  int on = 0;
+  for (int s = 0; s < sub.size; ++s) {
+    const double r = nrm.x() * (sub.x[s] - mid.x()) + nrm.y() * (sub.y[s] - mid.y());
+    on += r * r == ThresholdRef(m, nrm.x() * sub.rx[s] + nrm.y() * sub.ry[s]) ? 1 : 0;
+  }
+  return on;
+}
+
+// A corner's cost point by point: each edge's error as fitting.cc's EdgeError for a RANSAC
+// sample (+inf behind the corner along that edge by its threshold or more, else r^2 / t); the
+// nearer edge below 1 (edge 0 on a tie), else 1.
+double CornerCostRef(const PerpNoise& m, const Subset& sub, const Eigen::Vector2d& c,
+                     const Eigen::Vector2d& u0, const Eigen::Vector2d& u1, double bound, int* n0,
+                     int* n1) {
+  double cost = 0.0;
+  *n0 = *n1 = 0;
+  for (int s = 0; s < sub.size && cost < bound; ++s) {
+    const double vx = sub.x[s] - c.x(), vy = sub.y[s] - c.y();
+    const double a0 = u0.x() * vx + u0.y() * vy, a1 = u1.x() * vx + u1.y() * vy;
+    const double t0 = ThresholdRef(m, u1.x() * sub.rx[s] + u1.y() * sub.ry[s]);
+    const double t1 = ThresholdRef(m, u0.x() * sub.rx[s] + u0.y() * sub.ry[s]);
+    const double e0 = a0 < 0.0 && a0 * a0 >= t0 ? kInf : a1 * a1 / t0;
+    const double e1 = a1 < 0.0 && a1 * a1 >= t1 ? kInf : a0 * a0 / t1;
+    if (e0 < 1.0 && e0 <= e1) {
+      cost += e0;
+      ++*n0;
+    } else if (e1 < 1.0) {
+      cost += e1;
+      ++*n1;
+    } else {
+      cost += 1.0;
+    }
+  }
+  return cost;
+}
+
+// ---- Random scenes
+
+struct Draw {
+  explicit Draw(unsigned seed) : rng(seed) {}
+  double U(double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); }
+  int I(int a, int b) { return std::uniform_int_distribution<int>(a, b)(rng); }
+  double Quarters(int lo, int hi) { return 0.25 * I(lo, hi); }  // exact sums and products
+  bool OneIn(int k) { return I(1, k) == 1; }
+  std::mt19937 rng;
+};
+
+// Where a scene lies: on a quarter grid with axis-aligned frames (exact boundaries), or anywhere
+// at a scale from 1e-150 to 1e150, far from the origin.
+struct Placement {
+  bool grid = false;
+  double scale = 1.0;
+  double offset = 0.0;
+};
+
+Placement DrawPlacement(Draw& d) {
+  static constexpr double kScales[] = {1.0, 1e-3, 1e3, 1e-150, 1e150};
+  Placement p;
+  p.grid = d.OneIn(2);
+  p.scale = p.grid ? std::ldexp(1.0, d.I(-2, 2)) : kScales[d.I(0, 4)];
+  p.offset = p.scale * (d.OneIn(2) ? 0.0 : (p.grid ? 1048576.0 : 4.5e6));
+  return p;
+}
+
+RectFrame DrawFrame(Draw& d, const Placement& p) {
+  const double s = p.scale;
+  if (p.grid) {
+    static constexpr double kAxes[4][2] = {{1.0, 0.0}, {0.0, 1.0}, {-1.0, 0.0}, {0.0, -1.0}};
+    const int a = d.I(0, 3);
+    return {p.offset + s * d.Quarters(-8, 8), p.offset + s * d.Quarters(-8, 8), kAxes[a][0],
+            kAxes[a][1], s * d.Quarters(0, 16), s * d.Quarters(0, 6)};
+  }
+  const double theta = d.U(-kPi, kPi);
+  return {p.offset + s * d.U(-2.0, 2.0), p.offset + s * d.U(-2.0, 2.0), std::cos(theta),
+          std::sin(theta), s * d.U(0.0, 4.0), s * d.U(0.0, 1.5)};
+}
+
+// Returns scattered over the square of half size reach about frame f's centre (in its frame),
+// on the quarter grid or anywhere.
+void AddReturns(Draw& d, const Placement& p, const RectFrame& f, double reach, int n,
+                std::vector<double>* x, std::vector<double>* y) {
+  const int steps = static_cast<int>(4.0 * reach / p.scale) + 1;
+  for (int i = 0; i < n; ++i) {
+    const double qx = p.grid ? p.scale * d.Quarters(-steps, steps) : d.U(-reach, reach);
+    const double qy = p.grid ? p.scale * d.Quarters(-steps, steps) : d.U(-reach, reach);
+    x->push_back(f.cx + qx * f.ax - qy * f.ay);
+    y->push_back(f.cy + qx * f.ay + qy * f.ax);
+  }
+}
+
+// A part: n of the scene's returns in random order (the scene holds a few more).
+struct Part {
+  std::vector<double> x, y;
+  std::vector<std::int32_t> idx;
+};
+
+Part DrawPart(Draw& d, const Placement& p, const RectFrame& f, double margin, int n) {
+  Part part;
+  const double reach = std::max(f.hl, f.hw) + margin + p.scale;
+  AddReturns(d, p, f, reach, n + d.I(0, 4), &part.x, &part.y);
+  part.idx.resize(part.x.size());
+  std::iota(part.idx.begin(), part.idx.end(), 0);
+  std::shuffle(part.idx.begin(), part.idx.end(), d.rng);
+  part.idx.resize(static_cast<std::size_t>(n));
+  return part;
+}
+
+// ---- Association
+
+TEST(ReturnKernelsTest, NearestFaceOfTwoPointsIsEachPointsNearestFace) {
+  Draw d(11);
+  for (int trial = 0; trial < kTrials; ++trial) {
+    const Placement p = DrawPlacement(d);
+    const RectFrame f = DrawFrame(d, p);
+    const auto visible = static_cast<std::uint8_t>(d.I(0, 15));
+    std::vector<double> x, y;
+    AddReturns(d, p, f, f.hl + f.hw + p.scale, 2, &x, &y);
+    const BoxPoint q0 = InFrame(f, x[0], y[0]), q1 = InFrame(f, x[1], y[1]);
+    const Double2 d2 =
+        NearestFaceSq2(Double2{q0.x, q1.x}, Double2{q0.y, q1.y}, visible, f.hl, f.hw);
+    SCOPED_TRACE(trial);
+    EXPECT_EQ(d2[0], NearestFaceSqRef(q0, visible, f.hl, f.hw));
+    EXPECT_EQ(d2[1], NearestFaceSqRef(q1, visible, f.hl, f.hw));
+  }
+}
+
+TEST(ReturnKernelsTest, GateSumsAreThoseOfOneReturnAtATime) {
+  Draw d(12);
+  int stopped = 0, boundary = 0;
+  for (int trial = 0; trial < kTrials; ++trial) {
+    const Placement p = DrawPlacement(d);
+    const RectFrame box = DrawFrame(d, p);
+    const double margin = p.grid ? p.scale * d.Quarters(0, 6) : p.scale * d.U(0.0, 1.5);
+    const int n = d.I(0, 41);
+    const Part part = DrawPart(d, p, box, margin, n);
+    const auto visible = static_cast<std::uint8_t>(d.I(0, 15));
+    const auto max_outside = static_cast<std::size_t>(d.I(0, n));
+    const GateSums got = SumGate(box, margin, visible, max_outside, part.idx.data(),
+                                 part.idx.size(), part.x.data(), part.y.data());
+    const GateSums want = SumGateRef(box, margin, visible, max_outside, part.idx, part.x, part.y);
+    SCOPED_TRACE(trial);
+    EXPECT_EQ(got.inside, want.inside);
+    EXPECT_EQ(got.outside, want.outside);
+    EXPECT_EQ(got.dist_sum, want.dist_sum);
+    EXPECT_EQ(got.stopped, want.stopped);
+    stopped += want.stopped ? 1 : 0;
+    for (const std::int32_t i : part.idx) {
+      const BoxPoint q = InFrame(box, part.x, part.y, i);
+      boundary += std::abs(q.x) == box.hl + margin || std::abs(q.y) == box.hw + margin ? 1 : 0;
+    }
+  }
+  // The scenes reach the early stop and put returns exactly on the gate.
+  EXPECT_GT(stopped, kTrials / 10);
+  EXPECT_GT(boundary, kTrials / 10);
+}
+
+TEST(ReturnKernelsTest, ClaimCountIsThatOfOneReturnAtATime) {
+  Draw d(13);
+  for (int trial = 0; trial < kTrials; ++trial) {
+    const Placement p = DrawPlacement(d);
+    const RectFrame gate = DrawFrame(d, p);
+    const int n = d.I(0, 41);
+    const Part part = DrawPart(d, p, gate, 0.0, n);
+    const int limit = d.I(0, n + 2);
+    SCOPED_TRACE(trial);
+    EXPECT_EQ(CountInside(gate, part.idx.data(), part.idx.size(), part.x.data(), part.y.data(),
+                          limit),
+              CountInsideRef(gate, part.idx, part.x, part.y, limit));
+  }
+}
+
+// Claimants about the first: on the grid, some copies of an earlier claimant (exact ties).
+std::vector<RectFrame> DrawClaimants(Draw& d, const Placement& p) {
+  std::vector<RectFrame> claimants = {DrawFrame(d, p)};
+  const int m = d.I(1, 4);
+  while (static_cast<int>(claimants.size()) < m) {
+    const auto last = static_cast<int>(claimants.size()) - 1;
+    const bool copy = p.grid && d.OneIn(3);
+    claimants.push_back(copy ? claimants[static_cast<std::size_t>(d.I(0, last))] : DrawFrame(d, p));
+  }
+  return claimants;
+}
+
+TEST(ReturnKernelsTest, SplitKeepsTheFirstNearestClaimantOfEachReturn) {
+  Draw d(14);
+  for (int trial = 0; trial < kTrials; ++trial) {
+    const Placement p = DrawPlacement(d);
+    const std::vector<RectFrame> claimants = DrawClaimants(d, p);
+    const auto n = static_cast<std::size_t>(d.I(0, 41));
+    // As Associator::SplitAmong: side by side, an odd count padded with the last return.
+    std::vector<double> x, y;
+    AddReturns(d, p, claimants[0], 4.0 * p.scale + claimants[0].hl, static_cast<int>(n), &x, &y);
+    if (n % 2 == 1) {
+      x.push_back(x.back());
+      y.push_back(y.back());
+    }
+    std::vector<double> best_d(x.size(), kInf);
+    std::vector<std::int64_t> best(x.size(), 0);
+    for (std::size_t c = 0; c < claimants.size(); ++c) {
+      KeepNearer(claimants[c], static_cast<std::int64_t>(c), x.size(), x.data(), y.data(),
+                 best_d.data(), best.data());
+    }
+    SCOPED_TRACE(trial);
+    for (std::size_t k = 0; k < n; ++k) {
+      double want_d = kInf;
+      std::int64_t want = 0;
+      for (std::size_t c = 0; c < claimants.size(); ++c) {
+        const double dc = SplitDistanceRef(claimants[c], x[k], y[k]);
+        if (dc < want_d) {
+          want_d = dc;
+          want = static_cast<std::int64_t>(c);
+        }
+      }
+      EXPECT_EQ(best_d[k], want_d);
+      EXPECT_EQ(best[k], want);
+    }
+  }
+}
+
+// ---- RANSAC
+
+struct FitPoints {
+  std::vector<double> x, y, rx, ry;
+  Subset View() const {
+    return {x.data(), y.data(), rx.data(), ry.data(), static_cast<int>(x.size())};
+  }
+};
+
+// The noise model: dyadic on the grid (thresholds 1/16 to 4, hit exactly by grid residuals).
+PerpNoise DrawNoise(Draw& d, bool grid) {
+  if (grid) {
+    static constexpr double kSigma2[] = {0.0, 0.25, 0.75}, kSurface2[] = {0.0625, 0.25};
+    return {kSigma2[d.I(0, 2)], kSurface2[d.I(0, 1)], d.OneIn(2) ? 1.0 : 4.0,
+            d.OneIn(2) ? 0.0625 : 0.25};
+  }
+  const double sigma = d.U(0.0, 0.2), surface = d.U(0.0, 0.1), k = d.U(1.0, 4.0);
+  const double floor = d.OneIn(4) ? 0.0 : d.U(0.0, 0.1);
+  return {sigma * sigma, surface * surface, k * k, floor * floor};
+}
+
+// n points near edges leaving c along u0 (both ways) and along u1 (a corner), with outliers;
+// rays from a sensor away from them. On the grid: quarter-metre points and axis-aligned rays.
+FitPoints DrawFitPoints(Draw& d, bool grid, double scale, int n, const Eigen::Vector2d& c,
+                        const Eigen::Vector2d& u0, const Eigen::Vector2d& u1) {
+  static constexpr double kAxes[4][2] = {{1.0, 0.0}, {0.0, 1.0}, {-1.0, 0.0}, {0.0, -1.0}};
+  FitPoints p;
+  const double noise = d.U(0.0, 0.3), range = d.U(5.0, 40.0), bearing = d.U(-kPi, kPi);
+  const Eigen::Vector2d sensor = c + range * Eigen::Vector2d(std::cos(bearing), std::sin(bearing));
+  for (int i = 0; i < n; ++i) {
+    Eigen::Vector2d q, ray;
+    if (grid) {
+      q = c + Eigen::Vector2d(d.Quarters(-10, 10), d.Quarters(-10, 10));
+      const int a = d.I(0, 3);
+      ray = Eigen::Vector2d(kAxes[a][0], kAxes[a][1]);
+    } else {
+      const Eigen::Vector2d& along = d.OneIn(2) ? u0 : u1;
+      const Eigen::Vector2d across(-along.y(), along.x());
+      const Eigen::Vector2d outlier(d.U(-5.0, 5.0), d.U(-5.0, 5.0));
+      q = d.OneIn(5) ? Eigen::Vector2d(c + outlier)
+                     : Eigen::Vector2d(c + d.U(-1.0, 5.0) * along + d.U(-noise, noise) * across);
+      ray = (q - sensor).normalized();
+      q = scale * q;
+    }
+    p.x.push_back(q.x());
+    p.y.push_back(q.y());
+    p.rx.push_back(ray.x());
+    p.ry.push_back(ray.y());
+  }
+  return p;
+}
+
+// A model: an axis direction and a quarter-metre point on the grid, anywhere otherwise.
+void DrawModel(Draw& d, bool grid, Eigen::Vector2d* c, Eigen::Vector2d* u0) {
+  const double a = grid ? 0.5 * kPi * d.I(0, 3) : d.U(-kPi, kPi);
+  *u0 = grid ? Eigen::Vector2d(std::round(std::cos(a)), std::round(std::sin(a)))
+             : Eigen::Vector2d(std::cos(a), std::sin(a));
+  *c = grid ? Eigen::Vector2d(d.Quarters(-8, 8), d.Quarters(-8, 8))
+            : Eigen::Vector2d(d.U(-5.0, 5.0), d.U(-5.0, 5.0));
+}
+
+// No bound, none at all (0), or one the sum may reach part way (on the grid, in halves).
+double DrawBound(Draw& d, bool grid, int n) {
+  if (d.OneIn(3)) return kInf;
+  if (d.OneIn(8)) return 0.0;
+  return grid ? 0.5 * d.I(0, 2 * n) : d.U(0.0, n);
+}
+
+TEST(ReturnKernelsTest, EdgeCostIsThatOfOnePointAtATime) {
+  Draw d(15);
+  int cut = 0, on_threshold = 0;
+  for (int trial = 0; trial < kTrials; ++trial) {
+    const bool grid = d.OneIn(2);
+    const int n = d.I(0, 41);
+    Eigen::Vector2d mid, u;
+    DrawModel(d, grid, &mid, &u);
+    const Eigen::Vector2d nrm(-u.y(), u.x());
+    const double scale = grid || !d.OneIn(4) ? 1.0 : (d.OneIn(2) ? 1e-3 : 1e100);
+    const FitPoints pts = DrawFitPoints(d, grid, scale, n, mid, u, u);
+    const PerpNoise noise = DrawNoise(d, grid);
+    const double bound = DrawBound(d, grid, n);
+    int got_inliers = 0, want_inliers = 0;
+    const double got = EdgeCost(noise, pts.View(), scale * mid, nrm, bound, &got_inliers);
+    const double want = EdgeCostRef(noise, pts.View(), scale * mid, nrm, bound, &want_inliers);
+    SCOPED_TRACE(trial);
+    EXPECT_EQ(got, want);
+    EXPECT_EQ(got_inliers, want_inliers);
+    cut += want >= bound && n > 0 ? 1 : 0;
+    on_threshold += OnThreshold(noise, pts.View(), scale * mid, nrm);
+  }
+  // The scenes reach the early stop and put points exactly on the threshold.
+  EXPECT_GT(cut, kTrials / 10);
+  EXPECT_GT(on_threshold, kTrials / 10);
+}
+
+TEST(ReturnKernelsTest, CornerCostIsThatOfOnePointAtATime) {
+  Draw d(16);
+  int cut = 0;
+  for (int trial = 0; trial < kTrials; ++trial) {
+    const bool grid = d.OneIn(2);
+    const int n = d.I(0, 41);
+    Eigen::Vector2d corner, u0;
+    DrawModel(d, grid, &corner, &u0);
+    const Eigen::Vector2d u1(-u0.y(), u0.x());
+    const double scale = grid || !d.OneIn(4) ? 1.0 : (d.OneIn(2) ? 1e-3 : 1e100);
+    const FitPoints pts = DrawFitPoints(d, grid, scale, n, corner, u0, u1);
+    const PerpNoise noise = DrawNoise(d, grid);
+    const double bound = DrawBound(d, grid, n);
+    int got0 = -1, got1 = -1, want0 = -1, want1 = -1;
+    const double got = CornerCost(noise, pts.View(), scale * corner, u0, u1, bound, &got0, &got1);
+    const double want =
+        CornerCostRef(noise, pts.View(), scale * corner, u0, u1, bound, &want0, &want1);
+    SCOPED_TRACE(trial);
+    EXPECT_EQ(got, want);
+    EXPECT_EQ(got0, want0);
+    EXPECT_EQ(got1, want1);
+    cut += want >= bound && n > 0 ? 1 : 0;
+  }
+  EXPECT_GT(cut, kTrials / 10);  // the scenes reach the early stop
+}
+
+}  // namespace
+}  // namespace vtrack::internal

@@ -1,0 +1,257 @@
+// The per-return loops of association (association.cc) and RANSAC (fitting.cc) that run two
+// returns per step (double2.h). Each lane performs the operations of the one-return-at-a-time
+// code, and counts, early exits and sums go return by return in the original order, so every
+// result is bit for bit what a loop over one return at a time gives (no decision changes).
+// Internal to vtrack_core (compiled without floating-point contraction, like its callers); in a
+// header of their own so that a test can hold them against a scalar loop.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+
+#include "tracker/core/association.h"
+#include "tracker/core/double2.h"
+
+namespace vtrack::internal {
+
+// ---- Association
+
+// The distances of a return to a rectangle's faces are compared and summed once per return and
+// track, the costliest loops of a KITTI scan: squares are compared instead (sqrt is monotonic,
+// so sqrt(min(a, b)) = min(sqrt(a), sqrt(b)) exactly) and std::hypot's care for overflow,
+// needless for distances in metres, is left out (exact when one term is 0, within one ulp
+// otherwise).
+//
+// Squared distance of two box-frame points (qx, qy, lane by lane) to the nearest face in visible
+// (bit f: Face f, a segment of the boundary of the rectangle of half sizes half_l, half_w about
+// the origin), +inf if none; the faces in order, as std::min over them one point at a time.
+inline Double2 NearestFaceSq2(Double2 qx, Double2 qy, std::uint8_t visible, double half_l,
+                       double half_w);
+
+// The sums of Associator::PairCost over the returns (x[idx[k]], y[idx[k]]), k < n.
+struct GateSums {
+  std::size_t inside = 0;   // returns inside the rectangle grown by the margin (the gate)
+  std::size_t outside = 0;  // returns outside it
+  double dist_sum = 0.0;    // over the inside returns: sqrt(NearestFaceSq2), in return order
+  bool stopped = false;     // outside exceeded max_outside (the sums stop at that return)
+};
+// box: the rectangle's frame and half sizes; a return is outside the gate if |qx| > hl + margin
+// or |qy| > hw + margin in that frame.
+inline GateSums SumGate(const Associator::RectFrame& box, double margin, std::uint8_t visible,
+                 std::size_t max_outside, const std::int32_t* idx, std::size_t n,
+                 const double* x, const double* y);
+
+// The returns (x[idx[k]], y[idx[k]]), k < n, inside the rectangle gate (|qx| <= hl and
+// |qy| <= hw in its frame), counted in order up to limit (the count stops there).
+inline int CountInside(const Associator::RectFrame& gate, const std::int32_t* idx, std::size_t n,
+                const double* x, const double* y, int limit);
+
+// For returns (x[k], y[k]), k < n (even), the signed distance d to the boundary of rectangle f
+// (> 0 outside: the squared distance; <= 0 inside: minus the distance to the nearest side),
+// kept with c in best_d[k], best[k] where d < best_d[k]. Two returns per step, without branches.
+inline void KeepNearer(const Associator::RectFrame& f, std::int64_t c, std::size_t n, const double* x,
+                const double* y, double* best_d, std::int64_t* best);
+
+// ---- RANSAC
+
+// Floor of a point's distance variance [m^2]: keeps weights finite for a ray along a face.
+constexpr double kMinPerpVar = 1e-3 * 1e-3;
+
+// The noise model of a fit's inlier threshold.
+struct PerpNoise {
+  double sigma2 = 0.0;    // range variance
+  double surface2 = 0.0;  // surface variance
+  double k2 = 0.0;        // inlier_sigmas^2
+  double min_t2 = 0.0;    // squared threshold floor
+  // The squared threshold max(k2 * var, min_t2) of a face whose unit normal makes cosine cos_a
+  // with the ray, var = max(sigma2 * cos_a^2 + surface2, kMinPerpVar); two cosines, lane by lane.
+  Double2 PerpThreshold2(Double2 cos_a) const {
+    const Double2 var = Max2(Splat(sigma2) * cos_a * cos_a + Splat(surface2), Splat(kMinPerpVar));
+    return Max2(Splat(k2) * var, Splat(min_t2));
+  }
+};
+
+// The scoring subset of RANSAC: positions and unit rays from the sensor, side by side.
+struct Subset {
+  const double *x, *y, *rx, *ry;
+  int size;
+  Eigen::Vector2d P(int i) const { return {x[i], y[i]}; }
+};
+
+// The truncated cost of the edge through mid with unit normal nrm over the subset: per point in
+// order, r^2 / t where r^2 < t (an inlier, counted in *inliers), else 1 (r: the distance to the
+// edge, t: PerpThreshold2 of the normal's cosine with the ray); or any value >= bound once the
+// sum reaches bound (its terms are >= 0, so the full sum would too: the sample cannot be the
+// best, and the rest of the subset is not scored).
+inline double EdgeCost(const PerpNoise& noise, const Subset& sub, const Eigen::Vector2d& mid,
+                const Eigen::Vector2d& nrm, double bound, int* inliers);
+
+// The truncated cost of the corner at `corner` with edge k leaving along u_k (u1 = Perp(u0)):
+// per point p in order, with a_k = u_k . (p - corner), the residual of edge 0 is a_1 and that of
+// edge 1 is a_0, t_k is PerpThreshold2 of edge k's normal's cosine with the ray, e_0 = a_1^2 / t_0
+// and e_1 = a_0^2 / t_1 where below 1, else 1; edge k is not eligible (e_k = 1) where a_k < 0 and
+// a_k^2 >= t_k (behind the corner). The term is e_0 if e_0 < 1 and e_0 <= e_1 (counted in *n0),
+// else e_1 if e_1 < 1 (in *n1), else 1. Any value >= bound once the sum reaches bound, as
+// EdgeCost.
+inline double CornerCost(const PerpNoise& noise, const Subset& sub, const Eigen::Vector2d& corner,
+                  const Eigen::Vector2d& u0, const Eigen::Vector2d& u1, double bound, int* n0,
+                  int* n1);
+
+// ---- Definitions: inline, as they run inside their callers' per-pair and per-sample loops
+// (out of line, the pair cost took a third more instructions).
+
+inline Double2 NearestFaceSq2(Double2 qx, Double2 qy, std::uint8_t visible, double half_l,
+                       double half_w) {
+  const Double2 hl = Splat(half_l), hw = Splat(half_w), zero = Splat(0.0);
+  const Double2 off_x = Max2(Abs2(qx) - hl, zero), off_y = Max2(Abs2(qy) - hw, zero);
+  const auto sq = [](Double2 a, Double2 b) { return a * a + b * b; };
+  static_assert(static_cast<int>(Face::kFront) == 0 && static_cast<int>(Face::kLeft) == 1 &&
+                static_cast<int>(Face::kRear) == 2 && static_cast<int>(Face::kRight) == 3);
+  const Double2 face[4] = {sq(qx - hl, off_y), sq(qy - hw, off_x), sq(qx + hl, off_y),
+                           sq(qy + hw, off_x)};
+  Double2 d2 = Splat(std::numeric_limits<double>::infinity());
+  for (int f = 0; f < 4; ++f) {
+    if (visible & (1u << f)) d2 = face[f] < d2 ? face[f] : d2;  // std::min(d2, face)
+  }
+  return d2;
+}
+
+inline GateSums SumGate(const Associator::RectFrame& box, double margin, std::uint8_t visible,
+                 std::size_t max_outside, const std::int32_t* idx, std::size_t n,
+                 const double* x, const double* y) {
+  GateSums sums;
+  // Two returns per step (an odd last one twice, its second lane unused), then lane by lane in
+  // order: the same counts, early stop and sum as one return at a time.
+  const Double2 cx = Splat(box.cx), cy = Splat(box.cy);
+  const Double2 ax = Splat(box.ax), ay = Splat(box.ay);
+  const Double2 gate_l = Splat(box.hl + margin), gate_w = Splat(box.hw + margin);
+  for (std::size_t k = 0; k < n; k += 2) {
+    const auto i0 = static_cast<std::size_t>(idx[k]);
+    const auto i1 = static_cast<std::size_t>(idx[k + 1 < n ? k + 1 : k]);
+    const Double2 dx = Double2{x[i0], x[i1]} - cx, dy = Double2{y[i0], y[i1]} - cy;
+    const Double2 qx = dx * ax + dy * ay, qy = -dx * ay + dy * ax;  // the box frame
+    const Mask2 out = (Abs2(qx) > gate_l) | (Abs2(qy) > gate_w);
+    const Double2 d2 = NearestFaceSq2(qx, qy, visible, box.hl, box.hw);
+    for (std::size_t lane = 0; lane < 2 && k + lane < n; ++lane) {
+      if (out[lane]) {
+        sums.stopped = ++sums.outside > max_outside;
+        if (sums.stopped) return sums;
+        continue;
+      }
+      ++sums.inside;
+      sums.dist_sum += std::sqrt(d2[lane]);
+    }
+  }
+  return sums;
+}
+
+inline int CountInside(const Associator::RectFrame& gate, const std::int32_t* idx, std::size_t n,
+                const double* x, const double* y, int limit) {
+  const Double2 cx = Splat(gate.cx), cy = Splat(gate.cy), ax = Splat(gate.ax), ay = Splat(gate.ay);
+  const Double2 hl = Splat(gate.hl), hw = Splat(gate.hw);
+  // Two returns per step (an odd last one twice, its second lane unused): lane by lane the
+  // frame's doubles, counted lane by lane up to limit.
+  int inside = 0;
+  for (std::size_t k = 0; k < n && inside < limit; k += 2) {
+    const auto i0 = static_cast<std::size_t>(idx[k]);
+    const auto i1 = static_cast<std::size_t>(idx[k + 1 < n ? k + 1 : k]);
+    const Double2 dx = Double2{x[i0], x[i1]} - cx;
+    const Double2 dy = Double2{y[i0], y[i1]} - cy;
+    const Mask2 in = (Abs2(dx * ax + dy * ay) <= hl) & (Abs2(-dx * ay + dy * ax) <= hw);
+    inside += in[0] ? 1 : 0;
+    if (k + 1 < n && inside < limit) inside += in[1] ? 1 : 0;
+  }
+  return inside;
+}
+
+inline void KeepNearer(const Associator::RectFrame& f, std::int64_t c, std::size_t n, const double* x,
+                const double* y, double* best_d, std::int64_t* best) {
+  const Double2 cx = Splat(f.cx), cy = Splat(f.cy), ax = Splat(f.ax), ay = Splat(f.ay);
+  const Double2 hl = Splat(f.hl), hw = Splat(f.hw), zero = Splat(0.0);
+  const Mask2 claimant = {c, c};
+  for (std::size_t k = 0; k < n; k += 2) {
+    const Double2 px = Load2(x + k), py = Load2(y + k), old = Load2(best_d + k);
+    Mask2 old_best;
+    std::memcpy(&old_best, best + k, sizeof old_best);
+    const Double2 dx = px - cx, dy = py - cy;  // the rectangle's frame
+    const Double2 qx = dx * ax + dy * ay, qy = -dx * ay + dy * ax;
+    const Double2 ex = Abs2(qx) - hl, ey = Abs2(qy) - hw;
+    const Double2 ox = Max2(ex, zero), oy = Max2(ey, zero);
+    const Double2 d = ((ex > zero) | (ey > zero)) ? ox * ox + oy * oy : Max2(ex, ey);
+    const Mask2 nearer = d < old;
+    const Double2 new_d = nearer ? d : old;
+    const Mask2 new_best = nearer ? claimant : old_best;
+    std::memcpy(best_d + k, &new_d, sizeof new_d);
+    std::memcpy(best + k, &new_best, sizeof new_best);
+  }
+}
+
+inline double EdgeCost(const PerpNoise& noise, const Subset& sub, const Eigen::Vector2d& mid,
+                const Eigen::Vector2d& nrm, double bound, int* inliers) {
+  double cost = 0.0;
+  // Two points per step (an odd last one twice, its second lane unused), lane by lane the same
+  // doubles as one at a time; then summed and stopped at the bound one by one.
+  const Double2 mx = Splat(mid.x()), my = Splat(mid.y()), nx = Splat(nrm.x()), ny = Splat(nrm.y());
+  for (int s = 0; s < sub.size && cost < bound; s += 2) {
+    const int s1 = s + 1 < sub.size ? s + 1 : s;
+    const Double2 r = nx * (Double2{sub.x[s], sub.x[s1]} - mx) + ny * (Double2{sub.y[s], sub.y[s1]} - my);
+    const Double2 ca = nx * Double2{sub.rx[s], sub.rx[s1]} + ny * Double2{sub.ry[s], sub.ry[s1]};
+    // r^2 / t is only used below 1 (NoDivisionAbove in fitting.cc; both lanes divided at once).
+    const Double2 r2 = r * r, t = noise.PerpThreshold2(ca);
+    const Double2 e = r2 < t ? r2 / t : Splat(1.0);
+    for (int lane = 0; lane < 2 && s + lane < sub.size && (lane == 0 || cost < bound); ++lane) {
+      if (e[lane] < 1.0) {
+        cost += e[lane];
+        ++*inliers;
+      } else {
+        cost += 1.0;
+      }
+    }
+  }
+  return cost;
+}
+
+inline double CornerCost(const PerpNoise& noise, const Subset& sub, const Eigen::Vector2d& corner,
+                  const Eigen::Vector2d& u0, const Eigen::Vector2d& u1, double bound, int* n0,
+                  int* n1) {
+  double cost = 0.0;
+  *n0 = *n1 = 0;
+  // Two points per step (an odd last one twice, its second lane unused), lane by lane the same
+  // doubles as one at a time; then classified, summed and stopped at the bound one by one.
+  const Double2 cx = Splat(corner.x()), cy = Splat(corner.y()), zero = Splat(0.0), one = Splat(1.0);
+  const Double2 u0x = Splat(u0.x()), u0y = Splat(u0.y()), u1x = Splat(u1.x()), u1y = Splat(u1.y());
+  for (int s = 0; s < sub.size && cost < bound; s += 2) {
+    const int s1 = s + 1 < sub.size ? s + 1 : s;
+    const Double2 vx = Double2{sub.x[s], sub.x[s1]} - cx, vy = Double2{sub.y[s], sub.y[s1]} - cy;
+    const Double2 rx = {sub.rx[s], sub.rx[s1]}, ry = {sub.ry[s], sub.ry[s1]};
+    const Double2 a0 = u0x * vx + u0y * vy;  // along edge 0 = residual of edge 1
+    const Double2 a1 = u1x * vx + u1y * vy;  // along edge 1 = residual of edge 0
+    const Double2 t0 = noise.PerpThreshold2(u1x * rx + u1y * ry);
+    const Double2 t1 = noise.PerpThreshold2(u0x * rx + u0y * ry);
+    // e0 and e1 are only used below 1 (e0 <= e1 only once e0 < 1; for finite returns and rays,
+    // where neither is NaN): NoDivisionAbove in fitting.cc (both lanes divided at once; a
+    // quotient not chosen is not used).
+    const Double2 a0s = a0 * a0, a1s = a1 * a1;
+    const Double2 e0 = (((a0 >= zero) | (a0s < t0)) & (a1s < t0)) ? a1s / t0 : one;
+    const Double2 e1 = (((a1 >= zero) | (a1s < t1)) & (a0s < t1)) ? a0s / t1 : one;
+    for (int lane = 0; lane < 2 && s + lane < sub.size && (lane == 0 || cost < bound); ++lane) {
+      if (e0[lane] < 1.0 && e0[lane] <= e1[lane]) {
+        cost += e0[lane];
+        ++*n0;
+      } else if (e1[lane] < 1.0) {
+        cost += e1[lane];
+        ++*n1;
+      } else {
+        cost += 1.0;
+      }
+    }
+  }
+  return cost;
+}
+
+}  // namespace vtrack::internal

@@ -428,27 +428,44 @@ double DrawBound(Draw& d, bool grid, int n) {
   return grid ? 0.5 * d.I(0, 2 * n) : d.U(0.0, n);
 }
 
+// One scoring scene of RANSAC: n points about the model through c with direction u0 (an edge
+// along u0; a corner's second edge along its perpendicular), at a scale, with a noise model and
+// a bound on the cost.
+struct FitScene {
+  int n = 0;
+  Eigen::Vector2d c, u0, u1;
+  double scale = 1.0;
+  FitPoints pts;
+  PerpNoise noise;
+  double bound = 0.0;
+};
+FitScene DrawFitScene(Draw& d, bool corner) {
+  FitScene s;
+  const bool grid = d.OneIn(2);
+  s.n = d.I(0, 41);
+  DrawModel(d, grid, &s.c, &s.u0);
+  s.u1 = corner ? Eigen::Vector2d(-s.u0.y(), s.u0.x()) : s.u0;
+  s.scale = grid || !d.OneIn(4) ? 1.0 : (d.OneIn(2) ? 1e-3 : 1e100);
+  s.pts = DrawFitPoints(d, grid, s.scale, s.n, s.c, s.u0, s.u1);
+  s.noise = DrawNoise(d, grid);
+  s.bound = DrawBound(d, grid, s.n);
+  return s;
+}
+
 TEST(ReturnKernelsTest, EdgeCostIsThatOfOnePointAtATime) {
   Draw d(15);
   int cut = 0, on_threshold = 0;
   for (int trial = 0; trial < kTrials; ++trial) {
-    const bool grid = d.OneIn(2);
-    const int n = d.I(0, 41);
-    Eigen::Vector2d mid, u;
-    DrawModel(d, grid, &mid, &u);
-    const Eigen::Vector2d nrm(-u.y(), u.x());
-    const double scale = grid || !d.OneIn(4) ? 1.0 : (d.OneIn(2) ? 1e-3 : 1e100);
-    const FitPoints pts = DrawFitPoints(d, grid, scale, n, mid, u, u);
-    const PerpNoise noise = DrawNoise(d, grid);
-    const double bound = DrawBound(d, grid, n);
+    const FitScene s = DrawFitScene(d, /*corner=*/false);
+    const Eigen::Vector2d nrm(-s.u0.y(), s.u0.x()), mid = s.scale * s.c;
     int got_inliers = 0, want_inliers = 0;
-    const double got = EdgeCost(noise, pts.View(), scale * mid, nrm, bound, &got_inliers);
-    const double want = EdgeCostRef(noise, pts.View(), scale * mid, nrm, bound, &want_inliers);
+    const double got = EdgeCost(s.noise, s.pts.View(), mid, nrm, s.bound, &got_inliers);
+    const double want = EdgeCostRef(s.noise, s.pts.View(), mid, nrm, s.bound, &want_inliers);
     SCOPED_TRACE(trial);
     EXPECT_EQ(got, want);
     EXPECT_EQ(got_inliers, want_inliers);
-    cut += want >= bound && n > 0 ? 1 : 0;
-    on_threshold += OnThreshold(noise, pts.View(), scale * mid, nrm);
+    cut += want >= s.bound && s.n > 0 ? 1 : 0;
+    on_threshold += OnThreshold(s.noise, s.pts.View(), mid, nrm);
   }
   // The scenes reach the early stop and put points exactly on the threshold.
   EXPECT_GT(cut, kTrials / 10);
@@ -459,24 +476,18 @@ TEST(ReturnKernelsTest, CornerCostIsThatOfOnePointAtATime) {
   Draw d(16);
   int cut = 0;
   for (int trial = 0; trial < kTrials; ++trial) {
-    const bool grid = d.OneIn(2);
-    const int n = d.I(0, 41);
-    Eigen::Vector2d corner, u0;
-    DrawModel(d, grid, &corner, &u0);
-    const Eigen::Vector2d u1(-u0.y(), u0.x());
-    const double scale = grid || !d.OneIn(4) ? 1.0 : (d.OneIn(2) ? 1e-3 : 1e100);
-    const FitPoints pts = DrawFitPoints(d, grid, scale, n, corner, u0, u1);
-    const PerpNoise noise = DrawNoise(d, grid);
-    const double bound = DrawBound(d, grid, n);
+    const FitScene s = DrawFitScene(d, /*corner=*/true);
+    const Eigen::Vector2d corner = s.scale * s.c;
     int got0 = -1, got1 = -1, want0 = -1, want1 = -1;
-    const double got = CornerCost(noise, pts.View(), scale * corner, u0, u1, bound, &got0, &got1);
+    const double got =
+        CornerCost(s.noise, s.pts.View(), corner, s.u0, s.u1, s.bound, &got0, &got1);
     const double want =
-        CornerCostRef(noise, pts.View(), scale * corner, u0, u1, bound, &want0, &want1);
+        CornerCostRef(s.noise, s.pts.View(), corner, s.u0, s.u1, s.bound, &want0, &want1);
     SCOPED_TRACE(trial);
     EXPECT_EQ(got, want);
     EXPECT_EQ(got0, want0);
     EXPECT_EQ(got1, want1);
-    cut += want >= bound && n > 0 ? 1 : 0;
+    cut += want >= s.bound && s.n > 0 ? 1 : 0;
   }
   EXPECT_GT(cut, kTrials / 10);  // the scenes reach the early stop
 }

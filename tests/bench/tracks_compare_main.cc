@@ -9,8 +9,9 @@
 // speeds [m/s], sizes [m], covariances, the predicted trajectory) may differ by at most
 // --tolerance (default 0: bit for bit). --pred-only-vehicles: B may report no trajectory for a
 // track A predicts, if the track is not a vehicle. latency_us (wall clock) is not compared.
-// Prints the largest difference per field group. Exit 0 equal within the tolerance, 1 not, 2 bad
-// usage or unreadable logs.
+// Prints the largest difference per field group; where decisions differ, also the first message
+// that differs and the largest differences before it. Exit 0 equal within the tolerance, 1 not,
+// 2 bad usage or unreadable logs.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -134,19 +135,37 @@ int main(int argc, char** argv) {
   try {
     const auto a = ReadTracks(logs[0], channel), b = ReadTracks(logs[1], channel);
     long tracks = 0;
-    if (a.size() != b.size() || a.empty()) ++c.decisions_differ;
+    // The first message with a decision differing, and max_diff over the messages before it.
+    std::size_t first_differ = std::min(a.size(), b.size());
+    std::map<std::string, double> diff_before;
     for (std::size_t m = 0; m < std::min(a.size(), b.size()); ++m) {
+      const long before = c.decisions_differ;
+      const std::map<std::string, double> diff_so_far = c.max_diff;
       if (a[m].utime != b[m].utime || a[m].scan_seq != b[m].scan_seq || a[m].mode != b[m].mode ||
           a[m].num_tracks != b[m].num_tracks) {
         ++c.decisions_differ;
-        continue;
+      } else {
+        for (int k = 0; k < a[m].num_tracks; ++k) CompareTrack(a[m].tracks[k], b[m].tracks[k], &c);
+        tracks += a[m].num_tracks;
       }
-      for (int k = 0; k < a[m].num_tracks; ++k) CompareTrack(a[m].tracks[k], b[m].tracks[k], &c);
-      tracks += a[m].num_tracks;
+      if (c.decisions_differ > before && first_differ == std::min(a.size(), b.size())) {
+        first_differ = m;
+        diff_before = diff_so_far;
+      }
     }
+    if (a.size() != b.size() || a.empty()) ++c.decisions_differ;
     std::printf("tracks-compare: %zu / %zu messages, %ld tracks, %ld with different decisions, "
                 "%ld non-vehicle trajectories dropped\n",
                 a.size(), b.size(), tracks, c.decisions_differ, c.preds_dropped);
+    if (first_differ < std::min(a.size(), b.size())) {
+      std::printf("  the first decision differing is in message %zu (utime %lld); "
+                  "the messages before it:\n",
+                  first_differ, static_cast<long long>(a[first_differ].utime));
+      for (const auto& [group, d] : diff_before) {
+        std::printf("    max |diff| %-17s %.3g\n", group.c_str(), d);
+      }
+      std::printf("  all messages:\n");
+    }
     for (const auto& [group, d] : c.max_diff) std::printf("  max |diff| %-17s %.3g\n", group.c_str(), d);
     const bool ok = c.Within();
     std::printf("tracks-compare: %s (tolerance %g)\n", ok ? "equal" : "DIFFERENT", c.tolerance);

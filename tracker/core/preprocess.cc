@@ -68,8 +68,9 @@ bool Preprocessor::ComputeKnots(const LadarScan& scan, const PoseHistory& poses,
   const std::int64_t sweep = std::max<std::int64_t>(0, scan.sweep_duration_us);
   const std::int64_t step = params_.knot_us;
   const std::int64_t num_intervals = std::max<std::int64_t>(1, (sweep + step - 1) / step);
-  knot_m_.resize(static_cast<std::size_t>(num_intervals + 1));
-  knot_d_.resize(static_cast<std::size_t>(num_intervals));
+  // world_from_sensor's rows x and y at each knot, in double until the intervals are made.
+  std::vector<Eigen::Matrix<double, 2, 4>>& knot_m = knot_poses_;
+  knot_m.resize(static_cast<std::size_t>(num_intervals + 1));
   bool extrapolated = false;
   Eigen::Isometry3d world_from_body_start = Eigen::Isometry3d::Identity();
   for (std::int64_t k = 0; k <= num_intervals; ++k) {
@@ -84,11 +85,22 @@ bool Preprocessor::ComputeKnots(const LadarScan& scan, const PoseHistory& poses,
     if (st == PoseHistory::LookupStatus::kExtrapolated) extrapolated = true;
     if (k == 0) world_from_body_start = *world_from_body;
     const Eigen::Matrix4d world_from_sensor = (*world_from_body * scan.body_from_sensor).matrix();
-    knot_m_[static_cast<std::size_t>(k)] = world_from_sensor.topRows<2>();
+    knot_m[static_cast<std::size_t>(k)] = world_from_sensor.topRows<2>();
   }
+  knots_.resize(static_cast<std::size_t>(num_intervals));
   for (std::int64_t k = 0; k < num_intervals; ++k) {
-    knot_d_[static_cast<std::size_t>(k)] =
-        knot_m_[static_cast<std::size_t>(k + 1)] - knot_m_[static_cast<std::size_t>(k)];
+    const auto& m0 = knot_m[static_cast<std::size_t>(k)];
+    const std::int64_t length = std::min((k + 1) * step, sweep) - k * step;  // [us]
+    // A sweep of no duration has one interval of no length: no rate.
+    const Eigen::Matrix<double, 2, 4> rate =
+        length > 0 ? Eigen::Matrix<double, 2, 4>((knot_m[static_cast<std::size_t>(k + 1)] - m0) /
+                                                 static_cast<double>(length))
+                   : Eigen::Matrix<double, 2, 4>::Zero();
+    Knot& knot = knots_[static_cast<std::size_t>(k)];
+    knot.rotation.topRows<2>() = m0.leftCols<3>().cast<float>();
+    knot.rotation.bottomRows<2>() = rate.leftCols<3>().cast<float>();
+    knot.translation = m0.col(3);
+    knot.translation_rate = rate.col(3);
   }
   result->status = extrapolated ? CompensationStatus::kExtrapolated : CompensationStatus::kOk;
   result->world_from_body_start = world_from_body_start;
@@ -110,7 +122,7 @@ struct ReturnFilter {
   int num_rings = 1;
   bool has_ring = false;
   bool has_dt = false;
-  std::int64_t sweep = 0;         // [us]
+  std::int32_t sweep = 0;         // [us]
 
   ReturnFilter(const LadarScan& scan, const PreprocessParams& params) {
     const std::size_t n = scan.size();
@@ -127,36 +139,58 @@ struct ReturnFilter {
     num_rings = scan.num_rings;
     has_ring = scan.ring.size() == n;
     has_dt = scan.dt_us.size() == n;
-    sweep = std::max<std::int64_t>(0, scan.sweep_duration_us);
+    sweep = std::max<std::int32_t>(0, scan.sweep_duration_us);
   }
 
-  // True if return i is kept (its time after utime in *dt), else counts why not in *stats.
-  bool Keep(const LadarScan& scan, std::size_t i, PreprocessStats* stats, std::int64_t* dt) const {
-    const double px = scan.x[i], py = scan.y[i], pz = scan.z[i];
-    if (!std::isfinite(px) || !std::isfinite(py) || !std::isfinite(pz)) {
-      ++stats->nonfinite;
-      return false;
+  // Why each return is refused (a Refusal per return, kKept for those kept) into reason[0, n),
+  // in one pass that the compiler vectorises: no branch, every condition a lane mask. When
+  // several hold, the one of highest value names the reason: not finite, then beyond what the
+  // sensor measures, a bad ring, outside the tracker's range limits, a bad time.
+  enum Refusal : std::uint8_t {
+    kKept, kBadTime, kOutOfRange, kBadRing, kFar, kNonfinite, kNumRefusals
+  };
+  void Classify(const LadarScan& scan, std::uint8_t* reason) const {
+    if (has_ring && has_dt) return Classify<true, true>(scan, reason);
+    if (has_ring) return Classify<true, false>(scan, reason);
+    if (has_dt) return Classify<false, true>(scan, reason);
+    Classify<false, false>(scan, reason);
+  }
+  template <bool kRing, bool kDt>
+  void Classify(const LadarScan& scan, std::uint8_t* reason) const {
+    const std::size_t n = scan.size();
+    const float* const x = scan.x.data();
+    const float* const y = scan.y.data();
+    const float* const z = scan.z.data();
+    const std::int16_t* const ring = kRing ? scan.ring.data() : nullptr;
+    const std::int32_t* const dt = kDt ? scan.dt_us.data() : nullptr;
+    const float fmax = std::numeric_limits<float>::max();
+    const std::uint32_t ring_limit = static_cast<std::uint32_t>(std::max(num_rings, 0));
+    const std::uint32_t time_limit = static_cast<std::uint32_t>(sweep);
+    for (std::size_t i = 0; i < n; ++i) {
+      // Not finite: NaN fails every comparison, Inf is beyond the largest float.
+      const bool nonfinite =
+          !((std::abs(x[i]) <= fmax) & (std::abs(y[i]) <= fmax) & (std::abs(z[i]) <= fmax));
+      const double px = x[i], py = y[i], pz = z[i];
+      const double r2 = px * px + py * py + pz * pz;
+      // Ring in [-1, num_rings) (-1: unknown, a KITTI frame whose lasers could not be told
+      // apart: kept), time in [0, sweep]: one unsigned comparison each.
+      const bool bad_ring = kRing && static_cast<std::uint32_t>(ring[i] + 1) > ring_limit;
+      const bool bad_time = kDt && static_cast<std::uint32_t>(dt[i]) > time_limit;
+      const bool out_of_range = (r2 < min_r2) | (r2 > max_r2);
+      std::uint8_t r = bad_time ? kBadTime : kKept;
+      r = std::max<std::uint8_t>(r, out_of_range ? kOutOfRange : kKept);
+      r = std::max<std::uint8_t>(r, bad_ring ? kBadRing : kKept);
+      r = std::max<std::uint8_t>(r, r2 > far_r2 ? kFar : kKept);
+      reason[i] = std::max<std::uint8_t>(r, nonfinite ? kNonfinite : kKept);
     }
-    const double r2 = px * px + py * py + pz * pz;
-    if (r2 > far_r2) {
-      ++stats->far;
-      return false;
-    }
-    // -1: the ring is unknown (a KITTI frame whose lasers could not be told apart): kept.
-    if (has_ring && (scan.ring[i] < -1 || scan.ring[i] >= num_rings)) {
-      ++stats->bad_ring;
-      return false;
-    }
-    if (r2 < min_r2 || r2 > max_r2) {
-      ++stats->out_of_range;
-      return false;
-    }
-    *dt = has_dt ? scan.dt_us[i] : 0;
-    if (*dt < 0 || *dt > sweep) {
-      ++stats->bad_time;
-      return false;
-    }
-    return true;
+  }
+  // Counts the refused returns of each reason into *stats.
+  static void Count(const std::int64_t (&count)[kNumRefusals], PreprocessStats* stats) {
+    stats->nonfinite += count[kNonfinite];
+    stats->far += count[kFar];
+    stats->bad_ring += count[kBadRing];
+    stats->out_of_range += count[kOutOfRange];
+    stats->bad_time += count[kBadTime];
   }
 };
 
@@ -164,21 +198,15 @@ struct ReturnFilter {
 
 void Preprocessor::Compensate(const LadarScan& scan, PreprocessStats* stats, WorldPoints* out) {
   const std::size_t n = scan.size();
-  const std::int64_t sweep = std::max<std::int64_t>(0, scan.sweep_duration_us);
   const std::int64_t step = params_.knot_us;
-  const std::int64_t num_intervals = static_cast<std::int64_t>(knot_d_.size());
+  const std::int64_t last_interval = static_cast<std::int64_t>(knots_.size()) - 1;
   // Body-frame height of a return: the z row of body_from_sensor (the mounting is rigid).
-  const Eigen::Matrix<double, 1, 4> body_z = scan.body_from_sensor.matrix().row(2);
+  const Eigen::Vector4f body_z = scan.body_from_sensor.matrix().row(2).transpose().cast<float>();
   const ReturnFilter filter(scan, params_);
   const bool has_ring = filter.has_ring;
+  // dt / step without a 64-bit division per return: a floating-point guess, corrected to the
+  // exact quotient.
   const double inv_step = 1.0 / static_cast<double>(step);
-  if (fraction_.size() != static_cast<std::size_t>(step) + 1) {
-    fraction_.resize(static_cast<std::size_t>(step) + 1);
-    for (std::int64_t r = 0; r <= step; ++r) {
-      fraction_[static_cast<std::size_t>(r)] = static_cast<double>(r) / static_cast<double>(step);
-    }
-  }
-  const double* const fraction = fraction_.data();
   // Written by index into arrays sized for every return, trimmed at the end (no push_back). Not
   // cleared first: resize() then value-initialises only what the previous scan did not use.
   out->x.resize(n);
@@ -191,37 +219,44 @@ void Preprocessor::Compensate(const LadarScan& scan, PreprocessStats* stats, Wor
   float* const oh = out->height.data();
   std::int32_t* const oi = out->index.data();
   std::int16_t* const orng = out->ring.data();
+  const Knot* const knots = knots_.data();
+  // The scan's arrays through local pointers: the stores below could alias the vectors' own
+  // members, and the compiler would reload each pointer per return.
+  const float* const sx = scan.x.data();
+  const float* const sy = scan.y.data();
+  const float* const sz = scan.z.data();
+  const std::int16_t* const sring = has_ring ? scan.ring.data() : nullptr;
+  refusal_.resize(n);
+  filter.Classify(scan, refusal_.data());
+  const std::uint8_t* const refusal = refusal_.data();
+  const std::int32_t* const dts = filter.has_dt ? scan.dt_us.data() : nullptr;
+  std::int64_t refused[ReturnFilter::kNumRefusals] = {};
   std::size_t w = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    std::int64_t dt = 0;
-    if (!filter.Keep(scan, i, stats, &dt)) continue;
-    const double px = scan.x[i], py = scan.y[i], pz = scan.z[i];
-    // dt / step without a 64-bit division per return: a floating-point guess, corrected to the
-    // exact quotient.
+    if (refusal[i] != ReturnFilter::kKept) {
+      ++refused[refusal[i]];
+      continue;
+    }
+    const std::int64_t dt = dts != nullptr ? dts[i] : 0;
     std::int64_t q = static_cast<std::int64_t>(static_cast<double>(dt) * inv_step);
     if (q * step > dt) --q;
     if ((q + 1) * step <= dt) ++q;
-    const std::int64_t k = std::min<std::int64_t>(q, num_intervals - 1);
-    const std::int64_t t0 = k * step;
-    const std::int64_t t1 = std::min((k + 1) * step, sweep);
-    const double f = t1 - t0 == step ? fraction[dt - t0]
-                     : t1 > t0       ? static_cast<double>(dt - t0) / static_cast<double>(t1 - t0)
-                                     : 0.0;
-    const auto& m = knot_m_[static_cast<std::size_t>(k)];
-    const auto& d = knot_d_[static_cast<std::size_t>(k)];
-    // Both rows at once: a column of a 2x4 matrix is one SIMD pair, and each row gets the
-    // operations a row written out would, in the same order (the same doubles).
-    const Eigen::Vector2d wxy = (m.col(0) + f * d.col(0)) * px + (m.col(1) + f * d.col(1)) * py +
-                                (m.col(2) + f * d.col(2)) * pz + (m.col(3) + f * d.col(3));
-    const double wx = wxy.x(), wy = wxy.y();
-    const double zb = body_z(0) * px + body_z(1) * py + body_z(2) * pz + body_z(3);
-    ox[w] = wx;
-    oy[w] = wy;
-    oh[w] = static_cast<float>(zb);
+    const std::int64_t k = std::min(q, last_interval);
+    const Knot& knot = knots[k];
+    const float u = static_cast<float>(dt - k * step);  // [us] into the interval
+    const float px = sx[i], py = sy[i], pz = sz[i];
+    // 4-lane products, a column at a time: the rotation's rows and their rates applied at once.
+    const Eigen::Vector4f r =
+        knot.rotation.col(0) * px + knot.rotation.col(1) * py + knot.rotation.col(2) * pz;
+    const Eigen::Vector2d t = knot.translation + static_cast<double>(u) * knot.translation_rate;
+    ox[w] = t.x() + static_cast<double>(r(0) + u * r(2));
+    oy[w] = t.y() + static_cast<double>(r(1) + u * r(3));
+    oh[w] = body_z(0) * px + body_z(1) * py + body_z(2) * pz + body_z(3);
     oi[w] = static_cast<std::int32_t>(i);
-    orng[w] = has_ring ? scan.ring[i] : std::int16_t{0};
+    orng[w] = sring != nullptr ? sring[i] : std::int16_t{0};
     ++w;
   }
+  ReturnFilter::Count(refused, stats);
   out->x.resize(w);
   out->y.resize(w);
   out->height.resize(w);

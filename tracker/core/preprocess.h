@@ -23,6 +23,9 @@
 // matrix is interpolated linearly between knots per point. Against slerp at each point's own
 // time this errs by at most (omega * knot_us)^2 / 8 * range, e.g. 1 rad/s, 1 ms, 80 m: 1e-5 m
 // (tests/tracker/core/preprocess_test.cc checks it against PoseHistory::At per point).
+// The rotation of a return runs in single precision, four lanes at once (the two rows of the
+// rotation and of its rate); the world-scale translation stays in double. Against the same
+// interpolation in double a return moves by at most kCompensationTolerance (below).
 #pragma once
 
 #include <Eigen/Core>
@@ -54,6 +57,13 @@ struct WorldPoints {
   void reserve(std::size_t n);
   void push_back(double px, double py, float h, std::int32_t i, std::int16_t r);
 };
+
+// How far the single-precision compensation may place a return from the same interpolation in
+// double, per metre of the return's range from the sensor: the rotation of a return of range r
+// is a few float operations on values up to r, each rounding by at most 2^-24 r (6e-8 r), so
+// 1e-6 r (1.2e-4 m at 120 m) leaves a margin of ten. tests/tracker/core/preprocess_test.cc
+// holds the compensation to it against a double-precision reference.
+constexpr double kCompensationTolerance = 1e-6;  // [m per m of range]
 
 // No LADAR measures farther than this (the longest-range automotive ones reach ~500 m): a
 // return beyond it is refused as absurd ("far_point") when the scan states no max_range.
@@ -119,11 +129,17 @@ class Preprocessor {
   void RemoveGroundBand(WorldPoints* pts, PreprocessStats* stats) const;
 
   PreprocessParams params_;
-  // Knots: world_from_sensor rows x and y (3x4 each, as 2x4) and their differences.
-  std::vector<Eigen::Matrix<double, 2, 4>> knot_m_, knot_d_;
-  // fraction_[r] = r / knot_us for r in [0, knot_us]: a return's position within its knot
-  // interval by a look-up, not a division per return (the same quotients, computed once).
-  std::vector<double> fraction_;
+  // One interval between two knots, [t0, t0 + knot_us] of the sweep (the last one may be
+  // shorter): rows x and y of world_from_sensor at t0 and their rate of change, for a return u
+  // microseconds into it: world = (rotation rows 0-1 + u rows 2-3) p + translation + u rate.
+  struct Knot {
+    Eigen::Matrix<float, 4, 3> rotation;  // [-] rows 0-1 at t0, [1/us] rows 2-3 their rate
+    Eigen::Vector2d translation;          // [m] at t0
+    Eigen::Vector2d translation_rate;     // [m/us]
+  };
+  std::vector<Knot> knots_;
+  std::vector<Eigen::Matrix<double, 2, 4>> knot_poses_;  // rows x and y at each knot (scratch)
+  std::vector<std::uint8_t> refusal_;  // per return of the scan: why it is refused, 0 if kept
   // Ground grid.
   std::vector<float> cell_min_, cell_ground_, cell_bound_, cell_top_;
   std::vector<std::int32_t> point_cell_;

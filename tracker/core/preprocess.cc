@@ -324,8 +324,14 @@ void Preprocessor::RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts,
   // Locals: the stores below could alias the parameters, which would be reloaded per return.
   const double min_h = params_.min_height, max_h = params_.max_height;
   cell_top_.assign(cell_ground_.size(), 0.0f);
+  const float* const ground = cell_ground_.data();
   KeepAboveGround(
-      min_h, max_h, [&](std::size_t i) { return CellGround(grid, point_cell_[i], level); },
+      min_h, max_h,
+      [&](std::size_t i) {
+        // Computed once per cell, at its first return (NaN until then): the call only then.
+        const float g = ground[point_cell_[i]];
+        return std::isnan(g) ? CellGround(grid, point_cell_[i], level) : g;
+      },
       [&](std::size_t i, float h) {
         float& top = cell_top_[static_cast<std::size_t>(point_cell_[i])];
         top = std::max(top, h);
@@ -419,7 +425,6 @@ float Preprocessor::GroundLevel(const GroundGrid& grid) const {
 
 float Preprocessor::CellGround(const GroundGrid& grid, std::int32_t c, float level) {
   float& g = cell_ground_[static_cast<std::size_t>(c)];
-  if (!std::isnan(g)) return g;  // computed once per cell
   const int side = grid.side;
   // The lowest return of the 3 x 3 cells around, within the tolerance (growing with the
   // distance from the sensor by ground_max_slope) of the scan's level.

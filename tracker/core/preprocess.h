@@ -125,6 +125,7 @@ class Preprocessor {
   void BinLowestReturns(const GroundGrid& grid, const WorldPoints& pts);
   void BoundByGrade(const GroundGrid& grid);
   float GroundLevel(const GroundGrid& grid) const;
+  // The ground of a cell, computed and stored in cell_ground_ (the caller looks there first).
   float CellGround(const GroundGrid& grid, std::int32_t cell, float level);
   void RemoveGroundBand(WorldPoints* pts, PreprocessStats* stats) const;
 

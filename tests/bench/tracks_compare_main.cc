@@ -140,7 +140,9 @@ int main(int argc, char** argv) {
     std::map<std::string, double> diff_before;
     for (std::size_t m = 0; m < std::min(a.size(), b.size()); ++m) {
       const long before = c.decisions_differ;
-      const std::map<std::string, double> diff_so_far = c.max_diff;
+      const bool first_unset = first_differ == std::min(a.size(), b.size());
+      std::map<std::string, double> diff_so_far;
+      if (first_unset) diff_so_far = c.max_diff;
       if (a[m].utime != b[m].utime || a[m].scan_seq != b[m].scan_seq || a[m].mode != b[m].mode ||
           a[m].num_tracks != b[m].num_tracks) {
         ++c.decisions_differ;
@@ -148,7 +150,7 @@ int main(int argc, char** argv) {
         for (int k = 0; k < a[m].num_tracks; ++k) CompareTrack(a[m].tracks[k], b[m].tracks[k], &c);
         tracks += a[m].num_tracks;
       }
-      if (c.decisions_differ > before && first_differ == std::min(a.size(), b.size())) {
+      if (c.decisions_differ > before && first_unset) {
         first_differ = m;
         diff_before = diff_so_far;
       }

@@ -164,7 +164,8 @@ struct ReturnFilter {
     const std::int16_t* const ring = kRing ? scan.ring.data() : nullptr;
     const std::int32_t* const dt = kDt ? scan.dt_us.data() : nullptr;
     const float fmax = std::numeric_limits<float>::max();
-    const std::uint32_t ring_limit = static_cast<std::uint32_t>(std::max(num_rings, 0));
+    // ring + 1 must lie in [0, num_rings]; with num_rings < 0 no ring is valid, -1 included.
+    const std::uint32_t ring_end = static_cast<std::uint32_t>(std::max(num_rings + 1, 0));
     const std::uint32_t time_limit = static_cast<std::uint32_t>(sweep);
     for (std::size_t i = 0; i < n; ++i) {
       // Not finite: NaN fails every comparison, Inf is beyond the largest float.
@@ -174,7 +175,7 @@ struct ReturnFilter {
       const double r2 = px * px + py * py + pz * pz;
       // Ring in [-1, num_rings) (-1: unknown, a KITTI frame whose lasers could not be told
       // apart: kept), time in [0, sweep]: one unsigned comparison each.
-      const bool bad_ring = kRing && static_cast<std::uint32_t>(ring[i] + 1) > ring_limit;
+      const bool bad_ring = kRing && static_cast<std::uint32_t>(ring[i] + 1) >= ring_end;
       const bool bad_time = kDt && static_cast<std::uint32_t>(dt[i]) > time_limit;
       const bool out_of_range = (r2 < min_r2) | (r2 > max_r2);
       std::uint8_t r = bad_time ? kBadTime : kKept;

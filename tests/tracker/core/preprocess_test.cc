@@ -113,64 +113,98 @@ TEST(PreprocessTest, BadReturnsAreDroppedAndCounted) {
 }
 
 // A refused return is counted once, by the first reason that holds in the order not finite,
-// beyond the sensor's range, bad ring, outside the tracker's range limits, bad time.
+// beyond the sensor's range, bad ring, outside the tracker's range limits, bad time; a scan
+// without rings or without times is not refused for them.
 TEST(PreprocessTest, EachRefusedReturnIsCountedOnceByItsFirstReason) {
   const PoseHistory poses = MakePoses(1e-9, 1e-3, 0.3);
-  LadarScan scan;
-  scan.utime = kT0;
-  scan.sweep_duration_us = 1000;
-  scan.num_rings = 4;
-  scan.max_range = 100.0f;  // far: beyond 101 m
   const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
   struct Return {
-    float x;
+    float x, y, z;
     std::int16_t ring;
     std::int32_t dt;
   };
+  // num_rings 4, sweep 1000 us, the sensor's max_range 100 m (far: beyond 101 m), the tracker's
+  // range limits [1, 80] m. Reasons: with every array / without rings / without times.
   const std::vector<Return> returns = {
-      {5.0f, 0, 0},       // kept
-      {nan, 9, -5},       // not finite (also a bad ring and time)
-      {500.0f, 9, -5},    // far (also a bad ring, out of range and a bad time)
-      {5.0f, 9, -5},      // bad ring (also a bad time)
-      {5.0f, -1, 0},      // kept: ring unknown
-      {0.1f, 0, -5},      // out of range (also a bad time)
-      {90.0f, -2, 0},     // bad ring (also out of range)
-      {5.0f, 4, 0},       // bad ring: ring == num_rings
-      {5.0f, 3, -1},      // bad time
-      {5.0f, 3, 1000},    // kept: at the sweep's end
-      {5.0f, 3, 1001},    // bad time
+      {5, 0, 0, 0, 0},       //  0 kept
+      {nan, 0, 0, 9, -5},    //  1 not finite (also a bad ring and time)
+      {500, 0, 0, 9, -5},    //  2 far (also a bad ring, out of range, a bad time)
+      {5, 0, 0, 9, -5},      //  3 bad ring / bad time / bad ring
+      {5, 0, 0, -1, 0},      //  4 kept: ring unknown
+      {0.1f, 0, 0, 0, -5},   //  5 out of range (also a bad time)
+      {90, 0, 0, -2, 0},     //  6 bad ring / out of range / bad ring
+      {5, 0, 0, 4, 0},       //  7 bad ring (ring == num_rings) / kept / bad ring
+      {5, 0, 0, 3, -1},      //  8 bad time / bad time / kept
+      {5, 0, 0, 3, 1000},    //  9 kept: at the sweep's end
+      {5, 0, 0, 3, 1001},    // 10 bad time / bad time / kept
+      {5, inf, 0, 0, 0},     // 11 not finite
+      {5, 0, nan, 0, 0},     // 12 not finite
+      {-inf, 0, 0, 0, 0},    // 13 not finite
   };
-  for (const Return& r : returns) {
-    scan.x.push_back(r.x);
-    scan.y.push_back(0.0f);
-    scan.z.push_back(0.0f);
-    scan.intensity.push_back(0.0f);
-    scan.ring.push_back(r.ring);
-    scan.dt_us.push_back(r.dt);
-  }
-  PreprocessParams params;
-  params.ground_min_rings = 5;  // no ground removal: every kept return stays
-  Preprocessor pre(params);
+  auto run = [&](std::int16_t num_rings, bool rings, bool times, WorldPoints* out) {
+    LadarScan scan;
+    scan.utime = kT0;
+    scan.sweep_duration_us = 1000;
+    scan.num_rings = num_rings;
+    scan.max_range = 100.0f;
+    for (const Return& r : returns) {
+      scan.x.push_back(r.x);
+      scan.y.push_back(r.y);
+      scan.z.push_back(r.z);
+      scan.intensity.push_back(0.0f);
+      if (rings) scan.ring.push_back(r.ring);
+      if (times) scan.dt_us.push_back(r.dt);
+    }
+    PreprocessParams params;
+    params.ground_min_rings = 5;  // no ground removal: every kept return stays
+    Preprocessor pre(params);
+    return pre.Run(scan, poses, 0, out).stats;
+  };
+  auto indices = [](const WorldPoints& out) {
+    return std::vector<std::int32_t>(out.index.begin(), out.index.end());
+  };
   WorldPoints out;
-  const auto res = pre.Run(scan, poses, 0, &out);
-  EXPECT_EQ(res.stats.input, 11);
-  EXPECT_EQ(res.stats.nonfinite, 1);
-  EXPECT_EQ(res.stats.far, 1);
-  EXPECT_EQ(res.stats.bad_ring, 3);
-  EXPECT_EQ(res.stats.out_of_range, 1);
-  EXPECT_EQ(res.stats.bad_time, 2);
-  EXPECT_EQ(res.stats.kept, 3);
-  ASSERT_EQ(out.size(), 3u);
-  EXPECT_EQ(out.index[0], 0);
-  EXPECT_EQ(out.index[1], 4);
-  EXPECT_EQ(out.index[2], 9);
+  PreprocessStats st = run(4, true, true, &out);
+  EXPECT_EQ(st.input, 14);
+  EXPECT_EQ(st.nonfinite, 4);
+  EXPECT_EQ(st.far, 1);
+  EXPECT_EQ(st.bad_ring, 3);
+  EXPECT_EQ(st.out_of_range, 1);
+  EXPECT_EQ(st.bad_time, 2);
+  EXPECT_EQ(st.kept, 3);
+  EXPECT_EQ(indices(out), (std::vector<std::int32_t>{0, 4, 9}));
   EXPECT_EQ(out.ring[1], -1);
+
+  st = run(4, false, true, &out);  // no rings: none refused for its ring
+  EXPECT_EQ(st.nonfinite, 4);
+  EXPECT_EQ(st.far, 1);
+  EXPECT_EQ(st.bad_ring, 0);
+  EXPECT_EQ(st.out_of_range, 2);
+  EXPECT_EQ(st.bad_time, 3);
+  EXPECT_EQ(indices(out), (std::vector<std::int32_t>{0, 4, 7, 9}));
+
+  st = run(4, true, false, &out);  // no times: every return at the sweep's start
+  EXPECT_EQ(st.nonfinite, 4);
+  EXPECT_EQ(st.far, 1);
+  EXPECT_EQ(st.bad_ring, 3);
+  EXPECT_EQ(st.out_of_range, 1);
+  EXPECT_EQ(st.bad_time, 0);
+  EXPECT_EQ(indices(out), (std::vector<std::int32_t>{0, 4, 8, 9, 10}));
+
+  st = run(-1, true, true, &out);  // no ring can be valid, not even -1 (unknown)
+  EXPECT_EQ(st.nonfinite, 4);
+  EXPECT_EQ(st.far, 1);
+  EXPECT_EQ(st.bad_ring, 9);
+  EXPECT_EQ(st.kept, 0);
 }
 
 // The single-precision compensation against the same knot interpolation in double, computed
 // here from the pose history: every return within kCompensationTolerance of its range, with the
 // ego 3 km from the world origin (a world-scale translation in single precision would miss that
-// by 1e-4 m and more) turning at 1 rad/s, returns out to 120 m in every direction.
+// by 1e-4 m and more) turning at 1 rad/s, returns out to 120 m in every direction. Two sweeps:
+// one whose last knot interval is shorter than knot_us, one that knot_us divides (a return at
+// its very end lies on the last knot).
 TEST(PreprocessTest, SinglePrecisionCompensationStaysWithinItsToleranceOfDouble) {
   const double v = 15.0, w = 1.0;
   PoseHistory poses(10'000'000);
@@ -178,54 +212,58 @@ TEST(PreprocessTest, SinglePrecisionCompensationStaysWithinItsToleranceOfDouble)
   for (std::int64_t t = -50'000; t <= 300'000; t += 10'000) {
     poses.Add(kT0 + t, far_away * EgoAt(t * 1e-6, v, w));
   }
-  LadarScan scan;
-  scan.utime = kT0 + 50'000;
-  scan.sweep_duration_us = 99'500;  // a last knot interval shorter than knot_us
-  scan.num_rings = 1;
-  scan.body_from_sensor.translation() = Eigen::Vector3d(1.2, 0.3, 1.8);
-  scan.body_from_sensor.linear() = QuaternionFromRpy(0.02, 0.05, 0.3).toRotationMatrix();
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> ang(-kPi, kPi), elev(-0.4, 0.2), rr(1.5, 120.0);
-  std::uniform_int_distribution<std::int32_t> dtd(0, scan.sweep_duration_us);
-  for (int i = 0; i < 20000; ++i) {
-    const double a = ang(rng), e = elev(rng), r = rr(rng);
-    scan.x.push_back(static_cast<float>(r * std::cos(e) * std::cos(a)));
-    scan.y.push_back(static_cast<float>(r * std::cos(e) * std::sin(a)));
-    scan.z.push_back(static_cast<float>(r * std::sin(e)));
-    scan.intensity.push_back(0.0f);
-    // Every tenth return exactly on a knot: the end of one interval, the start of the next.
-    scan.dt_us.push_back(i % 10 == 0 ? (dtd(rng) / 1000) * 1000 : dtd(rng));
-    scan.ring.push_back(0);
+  for (const std::int32_t sweep : {99'500, 100'000}) {
+    LadarScan scan;
+    scan.utime = kT0 + 50'000;
+    scan.sweep_duration_us = sweep;
+    scan.num_rings = 1;
+    scan.body_from_sensor.translation() = Eigen::Vector3d(1.2, 0.3, 1.8);
+    scan.body_from_sensor.linear() = QuaternionFromRpy(0.02, 0.05, 0.3).toRotationMatrix();
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> ang(-kPi, kPi), elev(-0.4, 0.2), rr(1.5, 120.0);
+    std::uniform_int_distribution<std::int32_t> dtd(0, sweep);
+    for (int i = 0; i < 20000; ++i) {
+      const double a = ang(rng), e = elev(rng), r = rr(rng);
+      scan.x.push_back(static_cast<float>(r * std::cos(e) * std::cos(a)));
+      scan.y.push_back(static_cast<float>(r * std::cos(e) * std::sin(a)));
+      scan.z.push_back(static_cast<float>(r * std::sin(e)));
+      scan.intensity.push_back(0.0f);
+      // Every tenth return exactly on a knot (the end of one interval, the start of the next),
+      // every hundredth at the sweep's end.
+      const std::int32_t dt = dtd(rng);
+      scan.dt_us.push_back(i % 100 == 0 ? sweep : i % 10 == 0 ? dt / 1000 * 1000 : dt);
+      scan.ring.push_back(0);
+    }
+    PreprocessParams params;
+    params.max_range = 130.0;
+    Preprocessor pre(params);
+    WorldPoints out;
+    ASSERT_EQ(pre.Run(scan, poses, 0, &out).status, CompensationStatus::kOk);
+    ASSERT_EQ(out.size(), scan.size());
+    const std::int64_t step = params.knot_us;
+    auto world_from_sensor = [&](std::int64_t dt) {
+      return (*poses.At(scan.utime + dt, 0) * scan.body_from_sensor).matrix();
+    };
+    double worst = 0.0, worst_height = 0.0;  // [m per m of range]
+    for (std::size_t k = 0; k < out.size(); ++k) {
+      const auto i = static_cast<std::size_t>(out.index[k]);
+      const Eigen::Vector4d p(scan.x[i], scan.y[i], scan.z[i], 1.0);
+      const std::int64_t dt = scan.dt_us[i];
+      const std::int64_t t0 = std::min<std::int64_t>(dt / step, (sweep - 1) / step) * step;
+      const std::int64_t t1 = std::min<std::int64_t>(t0 + step, sweep);
+      const double f = static_cast<double>(dt - t0) / static_cast<double>(t1 - t0);
+      const Eigen::Matrix4d m0 = world_from_sensor(t0);
+      const Eigen::Vector4d ref = (m0 + f * (world_from_sensor(t1) - m0)) * p;
+      const double range = p.head<3>().norm();
+      worst = std::max(worst, std::hypot(out.x[k] - ref.x(), out.y[k] - ref.y()) / range);
+      const double height = (scan.body_from_sensor * p.head<3>()).z();
+      worst_height = std::max(worst_height, std::abs(out.height[k] - height) / range);
+    }
+    std::printf("sweep %d us: largest distance from the double-precision interpolation: %.2e m "
+                "per m of range (plane), %.2e (height)\n", sweep, worst, worst_height);
+    EXPECT_LE(worst, kCompensationTolerance) << "sweep " << sweep;
+    EXPECT_LE(worst_height, kCompensationTolerance) << "sweep " << sweep;
   }
-  PreprocessParams params;
-  params.max_range = 130.0;
-  Preprocessor pre(params);
-  WorldPoints out;
-  ASSERT_EQ(pre.Run(scan, poses, 0, &out).status, CompensationStatus::kOk);
-  ASSERT_EQ(out.size(), scan.size());
-  const std::int64_t step = params.knot_us, sweep = scan.sweep_duration_us;
-  auto world_from_sensor = [&](std::int64_t dt) {
-    return (*poses.At(scan.utime + dt, 0) * scan.body_from_sensor).matrix();
-  };
-  double worst = 0.0, worst_height = 0.0;  // [m per m of range]
-  for (std::size_t k = 0; k < out.size(); ++k) {
-    const auto i = static_cast<std::size_t>(out.index[k]);
-    const Eigen::Vector4d p(scan.x[i], scan.y[i], scan.z[i], 1.0);
-    const std::int64_t dt = scan.dt_us[i];
-    const std::int64_t t0 = std::min(dt / step, (sweep - 1) / step) * step;
-    const std::int64_t t1 = std::min(t0 + step, sweep);
-    const double f = static_cast<double>(dt - t0) / static_cast<double>(t1 - t0);
-    const Eigen::Matrix4d m0 = world_from_sensor(t0);
-    const Eigen::Vector4d ref = (m0 + f * (world_from_sensor(t1) - m0)) * p;
-    const double range = p.head<3>().norm();
-    worst = std::max(worst, std::hypot(out.x[k] - ref.x(), out.y[k] - ref.y()) / range);
-    const double height = (scan.body_from_sensor * p.head<3>()).z();
-    worst_height = std::max(worst_height, std::abs(out.height[k] - height) / range);
-  }
-  std::printf("largest distance from the double-precision interpolation: %.2e m per m of range "
-              "(plane), %.2e (height)\n", worst, worst_height);
-  EXPECT_LE(worst, kCompensationTolerance);
-  EXPECT_LE(worst_height, kCompensationTolerance);
 }
 
 TEST(PreprocessTest, NoPoseOrExtrapolationIsReported) {

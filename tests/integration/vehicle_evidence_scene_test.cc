@@ -107,11 +107,27 @@ void TrackStreet(const std::string& dir, const std::string& evidence_csv = "") {
   EXPECT_EQ(RunCommand(argv, dir + "/tracker.txt"), 0) << ReadFile(dir + "/tracker.txt");
 }
 
+// The street tracked once per process, without (plain) or with the fitting set's rows recorded
+// (dir/evidence.csv): the tests below share the two runs (each a 16 s 64-beam lap, the longest
+// part of this test under the sanitizers).
+const std::string& StreetDir(bool record_rows) {
+  static const std::string plain = [] {
+    const std::string dir = ScratchDir("vehicle_evidence_plain");
+    TrackStreet(dir);
+    return dir;
+  }();
+  static const std::string recorded = [] {
+    const std::string dir = ScratchDir("vehicle_evidence_recorded");
+    TrackStreet(dir, dir + "/evidence.csv");
+    return dir;
+  }();
+  return record_rows ? recorded : plain;
+}
+
 SceneCounts RunStreet() {
   SceneCounts n;
-  const std::string dir = ScratchDir("vehicle_evidence");
+  const std::string& dir = StreetDir(false);
   const std::string run = dir + "/run.lcm", tracks = dir + "/tracks.lcm";
-  TrackStreet(dir);
   const auto truth = Read<object_list_t>(run, "GROUND_TRUTH");
   const auto lists = Read<track_list_t>(tracks, "TRACKS");
   EXPECT_FALSE(lists.empty());
@@ -171,8 +187,7 @@ TEST(VehicleEvidenceTest, PostsNeverBecomeVehiclesAParkedCarSeenAlongOneSideDoes
 // row names a track of that scan's list, at its reported centre, and the list's
 // vehicle_probability is the sigmoid of the row's accumulated log-odds.
 TEST(VehicleEvidenceTest, EvidenceRowsAgreeWithThePublishedTracks) {
-  const std::string dir = ScratchDir("vehicle_evidence_csv");
-  TrackStreet(dir, dir + "/evidence.csv");
+  const std::string& dir = StreetDir(true);
   std::map<std::pair<std::int64_t, std::int64_t>, track_t> published;
   for (const track_list_t& list : Read<track_list_t>(dir + "/tracks.lcm", "TRACKS")) {
     for (const track_t& t : list.tracks) published[{list.utime, t.id}] = t;
@@ -213,10 +228,8 @@ TEST(VehicleEvidenceTest, EvidenceRowsAgreeWithThePublishedTracks) {
 // Recording the fitting set's rows (--evidence-csv) measures features no model of the defaults
 // uses (roughness); the tracks must not notice: the same TRACKS, field for field, as without.
 TEST(VehicleEvidenceTest, RecordingTheRowsLeavesTheTracksAsTheyAre) {
-  const std::string plain = ScratchDir("vehicle_evidence_plain");
-  const std::string recorded = ScratchDir("vehicle_evidence_recorded");
-  TrackStreet(plain);
-  TrackStreet(recorded, recorded + "/evidence.csv");
+  const std::string& plain = StreetDir(false);
+  const std::string& recorded = StreetDir(true);
   const auto a = Read<track_list_t>(plain + "/tracks.lcm", "TRACKS");
   const auto b = Read<track_list_t>(recorded + "/tracks.lcm", "TRACKS");
   ASSERT_GT(a.size(), 100u);

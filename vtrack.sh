@@ -65,7 +65,8 @@ configure_and_build() {
 }
 
 # The whole suite again under AddressSanitizer + UndefinedBehaviorSanitizer, built with clang
-# (whose UBSan also checks float-to-int overflow), -O1 with line tables and asserts on, no
+# (whose UBSan also checks float-to-int overflow), -O1 with line tables and asserts on (the test
+# sources themselves at -O0: half the compile time, tests/CMakeLists.txt), no
 # benchmarks (nothing they test that the tests do not), in its own tree; then a short smoke run
 # of every libFuzzer harness from the same tree (coverage from the harness files only: compiling
 # the libraries with coverage would cost more than the run; ./vtrack.sh fuzz has it all).
@@ -97,7 +98,7 @@ start_sanitizer_build() {
       -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
       -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
       -DVTRACK_SANITIZE=ON -DVTRACK_BUILD_FUZZERS=ON -DVTRACK_FUZZ_COVERAGE=OFF \
-      -DVTRACK_BUILD_BENCHMARKS=OFF && cmake --build "$2" -j "$3"' \
+      -DVTRACK_BUILD_BENCHMARKS=OFF -DVTRACK_TEST_COMPILE_OPTIONS=-O0 && cmake --build "$2" -j "$3"' \
     _ "$here" "$sanitizer_dir" "$jobs" >"$sanitizer_dir/build.log" 2>&1 &
   sanitizer_build_pid=$!
   background_pids+=("$sanitizer_build_pid")

@@ -4,6 +4,10 @@
 // the ground truth on it. The same scenario written by vtrack-sim-log (byte for byte the same
 // messages) is tracked offline, and the live TRACKS must match the offline ones; lcm-logplayer
 // feeding the same log live must give the same too.
+//
+// ctest runs the cases whose names hold Urban or Kitti (64-beam sweeps in real time) alone, as
+// tracker_live_test, and the others beside other tests, as tracker_live_single_plane_test
+// (tests/integration/CMakeLists.txt): a new 64-beam case needs such a name.
 #include <gtest/gtest.h>
 
 #include <chrono>

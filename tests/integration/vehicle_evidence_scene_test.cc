@@ -108,25 +108,30 @@ void TrackStreet(const std::string& dir, const std::string& evidence_csv = "") {
 }
 
 // The street tracked once per process, without (plain) or with the fitting set's rows recorded
-// (dir/evidence.csv): the tests below share the two runs (each a 16 s 64-beam lap, the longest
-// part of this test under the sanitizers).
-const std::string& StreetDir(bool record_rows) {
-  static const std::string plain = [] {
-    const std::string dir = ScratchDir("vehicle_evidence_plain");
-    TrackStreet(dir);
-    return dir;
+// (dir/evidence.csv), each by the first test that needs it: the tests below share the two runs
+// (each a 16 s 64-beam lap, the longest part of this test under the sanitizers). A run that
+// fails is reported by that first test; the others then find its files missing or short.
+const std::string& PlainStreetDir() {
+  static const std::string dir = [] {
+    const std::string d = ScratchDir("vehicle_evidence_plain");
+    TrackStreet(d);
+    return d;
   }();
-  static const std::string recorded = [] {
-    const std::string dir = ScratchDir("vehicle_evidence_recorded");
-    TrackStreet(dir, dir + "/evidence.csv");
-    return dir;
+  return dir;
+}
+
+const std::string& RecordedStreetDir() {
+  static const std::string dir = [] {
+    const std::string d = ScratchDir("vehicle_evidence_recorded");
+    TrackStreet(d, d + "/evidence.csv");
+    return d;
   }();
-  return record_rows ? recorded : plain;
+  return dir;
 }
 
 SceneCounts RunStreet() {
   SceneCounts n;
-  const std::string& dir = StreetDir(false);
+  const std::string& dir = PlainStreetDir();
   const std::string run = dir + "/run.lcm", tracks = dir + "/tracks.lcm";
   const auto truth = Read<object_list_t>(run, "GROUND_TRUTH");
   const auto lists = Read<track_list_t>(tracks, "TRACKS");
@@ -187,7 +192,7 @@ TEST(VehicleEvidenceTest, PostsNeverBecomeVehiclesAParkedCarSeenAlongOneSideDoes
 // row names a track of that scan's list, at its reported centre, and the list's
 // vehicle_probability is the sigmoid of the row's accumulated log-odds.
 TEST(VehicleEvidenceTest, EvidenceRowsAgreeWithThePublishedTracks) {
-  const std::string& dir = StreetDir(true);
+  const std::string& dir = RecordedStreetDir();
   std::map<std::pair<std::int64_t, std::int64_t>, track_t> published;
   for (const track_list_t& list : Read<track_list_t>(dir + "/tracks.lcm", "TRACKS")) {
     for (const track_t& t : list.tracks) published[{list.utime, t.id}] = t;
@@ -228,8 +233,8 @@ TEST(VehicleEvidenceTest, EvidenceRowsAgreeWithThePublishedTracks) {
 // Recording the fitting set's rows (--evidence-csv) measures features no model of the defaults
 // uses (roughness); the tracks must not notice: the same TRACKS, field for field, as without.
 TEST(VehicleEvidenceTest, RecordingTheRowsLeavesTheTracksAsTheyAre) {
-  const std::string& plain = StreetDir(false);
-  const std::string& recorded = StreetDir(true);
+  const std::string& plain = PlainStreetDir();
+  const std::string& recorded = RecordedStreetDir();
   const auto a = Read<track_list_t>(plain + "/tracks.lcm", "TRACKS");
   const auto b = Read<track_list_t>(recorded + "/tracks.lcm", "TRACKS");
   ASSERT_GT(a.size(), 100u);

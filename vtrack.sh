@@ -17,7 +17,7 @@ build_dir=${VTRACK_BUILD_DIR:-$here/build}
 jobs=${VTRACK_JOBS:-2}
 
 # Debian 12 packages, by purpose. Each command installs only what it needs and is missing.
-pkgs_build=(g++ make cmake pkg-config
+pkgs_build=(g++ make cmake pkg-config lld
   liblcm-dev liblcm-bin liblcm-java
   libeigen3-dev libyaml-cpp-dev libboost-program-options-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev

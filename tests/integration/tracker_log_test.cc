@@ -412,7 +412,7 @@ TEST_F(TrackerLogTest, EveryBadInputIsCountedInTrackerStatus) {
       if (scans == 20) {
         out.Write(ev->timestamp, "LADAR_SCAN", ev->data, 5);          // shorter than a fingerprint
         out.Write(ev->timestamp, "LADAR_SCAN", ev->data, size / 2);   // truncated
-        pose_t p;
+        const pose_t p{};
         write(ev->timestamp, "LADAR_SCAN", p);                        // another type
         const auto* bytes = static_cast<const std::uint8_t*>(ev->data);
         std::vector<std::uint8_t> inflated(bytes, bytes + size);

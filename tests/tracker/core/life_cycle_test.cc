@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
 #include <vector>
 
 namespace vtrack {
@@ -32,6 +33,32 @@ std::vector<char> Duplicates(const std::vector<Track>& tracks, const std::vector
   std::vector<char> remove(tracks.size(), 0);
   MarkDuplicates(TrackManagerParams{}, tracks, boxes, &remove);
   return remove;
+}
+
+TEST(LifeCycleTest, OverlapIsTheShareOfFifteenPointsOfTheSmallerBoxInsideTheOther) {
+  // Against the definition through OrientedBox's own methods, bit for bit: random boxes of any
+  // heading, size and offset, points of the smaller one on a 5 x 3 grid (0.2 of its length and
+  // 0.33 of its width apart) tested for lying inside the other.
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> pos(-4.0, 4.0), yaw(-4.0, 4.0), size(0.3, 12.0);
+  int partial = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const OrientedBox a{{pos(rng), pos(rng)}, yaw(rng), size(rng), size(rng)};
+    const OrientedBox b{{pos(rng), pos(rng)}, yaw(rng), size(rng), size(rng)};
+    const OrientedBox& small = a.length * a.width <= b.length * b.width ? a : b;
+    const OrientedBox& other = &small == &a ? b : a;
+    int inside = 0;
+    for (int i = 0; i < 5; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        inside += other.Contains(
+            small.ToWorld({(i - 2) * 0.2 * small.length, (j - 1) * 0.33 * small.width}));
+      }
+    }
+    ASSERT_EQ(Overlap(a, b), inside / 15.0) << "trial " << trial;
+    ASSERT_EQ(Overlap(b, a), inside / 15.0) << "trial " << trial;
+    partial += inside > 0 && inside < 15;
+  }
+  EXPECT_GT(partial, 1000);  // the boxes cross each other's edges often, not just miss or hold
 }
 
 TEST(LifeCycleTest, OfTwoDuplicatesTheOneWithLessVehicleEvidenceGoes) {

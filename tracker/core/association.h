@@ -40,6 +40,7 @@
 
 #include "base/assignment.h"
 #include "base/box.h"
+#include "tracker/core/parallel_for.h"
 #include "tracker/core/preprocess.h"
 #include "tracker/core/segmentation.h"
 #include "tracker/core/parameters.h"
@@ -80,6 +81,9 @@ struct AssociationResult {
 class Associator {
  public:
   explicit Associator(const AssociationParams& params);
+  // pool (null: none; else outliving this): its threads share the tracks' candidate pairs; the
+  // result does not depend on how many there are.
+  void SetPool(WorkerPool* pool) { pool_ = pool; }
 
   void Run(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
            const Segments& segments, const Eigen::Vector2d& sensor_xy, AssociationResult* out);
@@ -159,6 +163,7 @@ class Associator {
                  AssociationResult* out, std::vector<char>* own_valid) const;
 
   AssociationParams params_;
+  WorkerPool* pool_ = nullptr;
   // Scratch reused from scan to scan (no allocation per segment or part once warm).
   std::vector<Part> parts_;                // [0, num_parts_) in use; the rest keep their buffers
   std::size_t num_parts_ = 0;
@@ -170,6 +175,9 @@ class Associator {
   std::vector<double> split_d_;            // split: per return, its distance to the nearest claimant
   std::vector<std::int64_t> split_best_;   // split: per return, that claimant
   std::vector<Pair> pairs_;
+  // Candidate pairs: per block of tracks but the first, its pairs and its gate's candidates.
+  std::vector<std::vector<Pair>> block_pairs_;
+  std::vector<std::vector<std::int32_t>> block_candidates_;
   std::vector<int> row_of_, col_of_;       // assignment: track -> row, part -> column
   std::vector<double> cost_;               // assignment: cost matrix, row-major
   std::vector<char> own_valid_;            // merge: own_lo_/own_hi_ of a track are current

@@ -738,7 +738,7 @@ struct ComputeParams {
   template <class V>
   void Visit(V& v) {
     using namespace param;
-    v("threads", &threads, {"-", Closed(1, 64), "threads that update a scan's tracks at once (each track's update is independent of the others'); 1: all on the calling thread. 2 on a 2-core computer: KITTI 0000 bench, see docs/results.md"});
+    v("threads", &threads, {"-", Closed(1, 64), "threads that share a scan's loops: the returns' placement and ground cells, the range profile beside the segmentation, the tracks' candidate pairs and their updates (each part independent of the others); 1: all on the calling thread. 2 on a 2-core computer: KITTI 0000 bench, see docs/results.md"});
   }
   bool Validate(std::string* error) const { return param::Validate(*this, error); }
 };

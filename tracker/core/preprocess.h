@@ -35,6 +35,7 @@
 #include <vector>
 
 #include "base/pose.h"
+#include "tracker/core/parallel_for.h"
 #include "tracker/core/parameters.h"
 #include "tracker/core/scan.h"
 
@@ -100,6 +101,9 @@ struct PreprocessResult {
 class Preprocessor {
  public:
   explicit Preprocessor(const PreprocessParams& params);
+  // pool (null: none; else outliving this): its threads place the returns and bin them in the
+  // ground grid; the results do not depend on how many there are.
+  void SetPool(WorkerPool* pool) { pool_ = pool; }
 
   // Fills *out (cleared first). max_extrapolation_us: how far past the newest pose a return's
   // time may lie. With no pose for part of the sweep, status is kNoPose and *out is empty.
@@ -116,6 +120,11 @@ class Preprocessor {
                     std::int64_t max_extrapolation_us, PreprocessResult* result);
   // Every usable return placed in the world (counts what is not in *stats).
   void Compensate(const LadarScan& scan, PreprocessStats* stats, WorldPoints* out);
+  // The kept returns of [begin, end) of the scan (refusal_ says which) placed in the world,
+  // written to *out's arrays (sized already) from index first_out on; each refused one counted
+  // by its reason in refused[0, kNumRefusals).
+  void PlaceReturns(const LadarScan& scan, std::size_t begin, std::size_t end,
+                    std::size_t first_out, WorldPoints* out, std::int64_t* refused) const;
   // The ground grid (cells of ground_cell around the sensor, one spare ring at the edge).
   struct GroundGrid {
     int side = 0;          // [cells]
@@ -132,6 +141,7 @@ class Preprocessor {
   void RemoveGroundBand(WorldPoints* pts, PreprocessStats* stats) const;
 
   PreprocessParams params_;
+  WorkerPool* pool_ = nullptr;
   // One interval between two knots, [t0, t0 + knot_us] of the sweep (the last one may be
   // shorter): rows x and y of world_from_sensor at t0 and their rate of change, for a return u
   // microseconds into it: world = (rotation rows 0-1 + u rows 2-3) p + translation + u rate.
@@ -145,6 +155,7 @@ class Preprocessor {
   std::vector<std::uint8_t> refusal_;  // per return of the scan: why it is refused, 0 if kept
   // Ground grid.
   std::vector<float> cell_min_, cell_ground_, cell_bound_, cell_top_;
+  std::vector<std::vector<float>> worker_cell_min_;  // per thread but the first: its cell_min_
   std::vector<std::int32_t> point_cell_;
 };
 

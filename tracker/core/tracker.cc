@@ -8,7 +8,6 @@
 
 #include "base/angle.h"
 #include "tracker/core/grazing_pieces.h"
-#include "tracker/core/parallel_for.h"
 
 namespace vtrack {
 namespace {
@@ -62,6 +61,9 @@ Tracker::Tracker(const TrackerParams& params, bool debug)
     column_top_used_[three_d ? 1 : 0] =
         UsesFeature(params_.evidence, three_d, EvidenceFeature::kColumnTop);
   }
+  pool_ = std::make_unique<WorkerPool>(params_.compute.threads);
+  preprocessor_.SetPool(pool_.get());
+  associator_.SetPool(pool_.get());
   for (int k = 0; k < params_.compute.threads; ++k) {
     workers_.emplace_back(params_.outline, manager_->NewMeasurer());
   }
@@ -167,15 +169,23 @@ bool Tracker::Process(const LadarScan& scan, bool extrapolate, ScanOutput* out) 
   out->utime = scan.utime;
   out->seq = scan.seq;
   out->stats = pre.stats;
-  // Segmentation, then the pieces of faces seen at a grazing angle joined.
-  segmenter_.Run(points_, scan.num_rings <= 1, pre.sensor_xy, &segments_);
-  JoinGrazingPieces(points_, pre.sensor_xy, params_.grazing, &segments_);
-  out->num_segments = static_cast<std::int32_t>(segments_.segments.size());
-  IndexSegments();
-  top_ring_ = TopRing(scan);
+  // The scan's range profile (read by the updates) is built on a second thread while this one
+  // segments: both only read the returns, and each writes its own result.
+  pool_->ParallelFor(2, [&](std::size_t task, int) {
+    if (task == 1) {
+      BuildProfile(scan, pre.sensor_xy);
+      return;
+    }
+    // Segmentation, then the pieces of faces seen at a grazing angle joined.
+    segmenter_.Run(points_, scan.num_rings <= 1, pre.sensor_xy, &segments_);
+    JoinGrazingPieces(points_, pre.sensor_xy, params_.grazing, &segments_);
+    IndexSegments();
+  });
   // Association with the tracks predicted to the middle of the sweep.
   manager_->Predict(scan.utime + scan.sweep_duration_us / 2, &predicted_);
   associator_.Run(predicted_, points_, segments_, pre.sensor_xy, &association_);
+  out->num_segments = static_cast<std::int32_t>(segments_.segments.size());
+  top_ring_ = TopRing(scan);
   MarkUnobserved(scan, extrapolate);
   // Each track updated with its returns; new tracks from what is left; life cycle; report.
   UpdateTracks(scan, pre.sensor_xy, out);
@@ -248,15 +258,13 @@ void Tracker::MarkUnobserved(const LadarScan& scan, bool extrapolate) {
                      " tracks in lost wedges not counted as missed");
 }
 
-void Tracker::UpdateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_xy,
-                           ScanOutput* out) {
+void Tracker::BuildProfile(const LadarScan& scan, const Eigen::Vector2d& sensor_xy) {
   // 3-D clouds only: a single-plane scanner's bearing spacing (0.5 deg or more) leaves bins of
   // the profile empty between its returns, which would read as free space beyond a face's end.
   // The vehicle evidence asks a single-plane scan's profile too, binned at 1.5 bearing steps so
   // that no bin between the returns of one face is empty (hidden_ends); the orientation rules
   // are given the 3-D profile only.
-  const bool multi_ring = scan.num_rings > 1;
-  if (multi_ring) {
+  if (scan.num_rings > 1) {
     profile_.Build(sensor_xy, points_.x, points_.y, points_.ring,
                    std::max(kMinRangeProfileBinDeg, params_.outline.bin_deg));
   } else {
@@ -264,12 +272,17 @@ void Tracker::UpdateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_
     profile_.Build(sensor_xy, points_.x, points_.y,
                    std::max(kMinRangeProfileBinDeg, 1.5 * (step_deg > 0.0 ? step_deg : 1.0)));
   }
+}
+
+void Tracker::UpdateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_xy,
+                           ScanOutput* out) {
+  const bool multi_ring = scan.num_rings > 1;
   for (const AzimuthWedge& w : lost_world_) profile_.MarkUnseen(w.begin, w.end);
   const std::size_t num_tracks = manager_->tracks().size();
   // Each track's update touches that track only (and its worker's scratch): the tracks are
   // shared among the threads, and what they add to the output is appended in track order.
   update_out_.resize(num_tracks);
-  ParallelFor(num_tracks, static_cast<int>(workers_.size()), [&](std::size_t j, int w) {
+  pool_->ParallelFor(num_tracks, [&](std::size_t j, int w) {
     UpdateTrack(j, scan, sensor_xy, multi_ring, &workers_[static_cast<std::size_t>(w)],
                 &update_out_[j]);
   });

@@ -28,6 +28,7 @@
 #include "tracker/core/association.h"
 #include "tracker/core/ekf.h"
 #include "tracker/core/outline.h"
+#include "tracker/core/parallel_for.h"
 #include "tracker/core/preprocess.h"
 #include "tracker/core/range_profile.h"
 #include "tracker/core/scan.h"
@@ -116,6 +117,9 @@ class Tracker {
   // Marks in unobserved_ the tracks whose centre predicted to mid-sweep (predicted_) lies in a
   // lost wedge of the sweep, seen from the sensor at mid-sweep; counts them and the sweep.
   void MarkUnobserved(const LadarScan& scan, bool extrapolate);
+  // The scan's range profile (profile_) from the returns of points_, before the lost wedges are
+  // marked in it (UpdateTracks).
+  void BuildProfile(const LadarScan& scan, const Eigen::Vector2d& sensor_xy);
   // Updates every track with its returns (a miss if none, unless it was not observed).
   void UpdateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_xy, ScanOutput* out);
   // New tracks from the objects association left over.
@@ -154,6 +158,9 @@ class Tracker {
   ScanSequencer sequencer_;
   std::unique_ptr<Ekf> ekf_;
   std::unique_ptr<TrackManager> manager_;
+  // compute.threads threads for the loops of a scan (the updates, the preprocessing), started
+  // once.
+  std::unique_ptr<WorkerPool> pool_;
   Preprocessor preprocessor_;
   Segmenter segmenter_;
   Associator associator_;

@@ -7,9 +7,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <random>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "base/angle.h"
 #include "tests/support/params_check.h"
@@ -375,6 +378,66 @@ TEST(AssociatorTest, SideOfALongMoverSeenEdgeOnJoinsIt) {
   assoc.Run({truck}, pts, segs, sensor, &res);
   EXPECT_EQ(static_cast<int>(res.track_points[0].size()), front);
   EXPECT_EQ(res.new_objects.size(), 4u);
+}
+
+TEST(AssociatorTest, AnyNumberOfThreadsGivesTheSameAssociation) {
+  // A car park of 160 cars in rows 4 m apart (neighbours' gates overlap, so tracks compete for
+  // parts), tracked by 150 tracks predicted up to 0.6 m off (ten cars are new, a few tracks
+  // tentative), some pairs of cars so close that one segment holds both: enough tracks for the
+  // candidate pairs to be shared among threads. One thread's result is what any number of
+  // threads must give.
+  const Eigen::Vector2d sensor(0, 0);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> off(-0.6, 0.6), yaw(-0.1, 0.1);
+  WorldPoints pts;
+  std::vector<std::pair<int, int>> ranges;
+  std::vector<PredictedObject> tracks;
+  for (int k = 0; k < 160; ++k) {
+    const double x = -50.0 + 6.5 * (k % 16), y = (k / 16 % 2 == 0 ? 8.0 : -8.0) + 4.0 * (k / 32);
+    const OrientedBox car{{x, y}, yaw(rng), 4.5, 1.8};
+    const int first = static_cast<int>(pts.size());
+    AddBoxReturns(car, sensor, &pts);
+    if (k % 7 == 3 && !ranges.empty()) {
+      ranges.back().second = static_cast<int>(pts.size());  // one segment with the car before
+    } else {
+      ranges.push_back({first, static_cast<int>(pts.size())});
+    }
+    if (k % 16 != 5) {
+      tracks.push_back(Pred(x + off(rng), y + off(rng), car.theta + yaw(rng), k % 11 != 0));
+    }
+  }
+  const Segments segs = SegmentsOf(pts, ranges);
+  auto run = [&](int threads) {
+    WorkerPool pool(threads);
+    Associator assoc(AssociationParams{});
+    assoc.SetPool(&pool);
+    AssociationResult res;
+    assoc.Run(tracks, pts, segs, sensor, &res);
+    return res;
+  };
+  const AssociationResult one = run(1);
+  ASSERT_EQ(one.track_points.size(), tracks.size());
+  std::size_t assigned = 0;
+  for (const auto& idx : one.track_points) assigned += idx.empty() ? 0 : 1;
+  EXPECT_GT(assigned, 120u);
+  EXPECT_GT(one.num_split, 0);
+  EXPECT_FALSE(one.new_objects.empty());
+  for (const int threads : {2, 3}) {
+    SCOPED_TRACE("threads " + std::to_string(threads));
+    const AssociationResult many = run(threads);
+    EXPECT_EQ(many.track_points, one.track_points);
+    ASSERT_EQ(many.track_cost.size(), one.track_cost.size());
+    for (std::size_t j = 0; j < one.track_cost.size(); ++j) {
+      // Bit for bit (NaN for a track left unassigned).
+      EXPECT_TRUE(many.track_cost[j] == one.track_cost[j] ||
+                  (std::isnan(many.track_cost[j]) && std::isnan(one.track_cost[j])))
+          << "track " << j;
+    }
+    EXPECT_EQ(many.new_objects, one.new_objects);
+    EXPECT_EQ(many.num_split, one.num_split);
+    EXPECT_EQ(many.num_merged, one.num_merged);
+    EXPECT_EQ(many.num_ignored, one.num_ignored);
+  }
 }
 
 TEST(AssociatorTest, ValidateNamesTheKey) {

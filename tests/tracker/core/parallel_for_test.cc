@@ -1,9 +1,11 @@
-// ParallelFor: every index is called exactly once whatever the number of threads, the calls do
-// run on more than one thread when asked, and an exception of one call reaches the caller.
+// WorkerPool: every index is called exactly once whatever the number of threads, loop after loop
+// on the same pool, the calls do run on more than one thread when asked, and an exception of one
+// call reaches the caller and leaves the pool usable.
 #include "tracker/core/parallel_for.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <mutex>
@@ -15,29 +17,35 @@
 namespace vtrack {
 namespace {
 
-TEST(ParallelFor, CallsEveryIndexOnceWithAWorkerBelowTheThreadCount) {
-  for (const int threads : {1, 2, 3, 8}) {
-    for (const std::size_t n : {0u, 1u, 2u, 5u, 1000u}) {
-      std::vector<std::atomic<int>> calls(n);
-      std::atomic<int> bad_worker{0};
-      ParallelFor(n, threads, [&](std::size_t i, int worker) {
-        calls[i].fetch_add(1);
-        if (worker < 0 || worker >= threads) bad_worker.fetch_add(1);
-      });
-      for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(calls[i].load(), 1) << "index " << i;
-      EXPECT_EQ(bad_worker.load(), 0);
+TEST(WorkerPool, CallsEveryIndexOnceWithAWorkerBelowTheThreadCount) {
+  for (const int threads : {0, 1, 2, 3, 8}) {
+    WorkerPool pool(threads);
+    EXPECT_EQ(pool.threads(), std::max(threads, 1));
+    // Many loops in a row on one pool, of every size, as the tracker runs them scan after scan.
+    for (int round = 0; round < 50; ++round) {
+      for (const std::size_t n : {0u, 1u, 2u, 5u, 1000u}) {
+        std::vector<std::atomic<int>> calls(n);
+        std::atomic<int> bad_worker{0};
+        pool.ParallelFor(n, [&](std::size_t i, int worker) {
+          calls[i].fetch_add(1);
+          if (worker < 0 || worker >= pool.threads()) bad_worker.fetch_add(1);
+        });
+        for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(calls[i].load(), 1) << "index " << i;
+        ASSERT_EQ(bad_worker.load(), 0);
+      }
     }
   }
 }
 
-TEST(ParallelFor, RunsOnMoreThanOneThreadWhenAsked) {
+TEST(WorkerPool, RunsOnMoreThanOneThreadWhenAsked) {
   // Each call waits until another thread has started one (or 0.2 s pass): with one thread the
   // waits time out, with two they do not.
   auto threads_seen = [](int threads) {
+    WorkerPool pool(threads);
     std::mutex m;
     std::set<std::thread::id> ids;
     std::atomic<int> started{0};
-    ParallelFor(8, threads, [&](std::size_t, int) {
+    pool.ParallelFor(8, [&](std::size_t, int) {
       {
         std::lock_guard<std::mutex> lock(m);
         ids.insert(std::this_thread::get_id());
@@ -52,16 +60,21 @@ TEST(ParallelFor, RunsOnMoreThanOneThreadWhenAsked) {
   EXPECT_EQ(threads_seen(2), 2u);
 }
 
-TEST(ParallelFor, AnExceptionOfOneCallReachesTheCaller) {
+TEST(WorkerPool, AnExceptionOfOneCallReachesTheCallerAndThePoolGoesOn) {
   for (const int threads : {1, 2}) {
+    WorkerPool pool(threads);
     std::atomic<int> calls{0};
-    EXPECT_THROW(ParallelFor(100, threads,
-                             [&](std::size_t i, int) {
-                               calls.fetch_add(1);
-                               if (i == 7) throw std::runtime_error("index 7");
-                             }),
+    EXPECT_THROW(pool.ParallelFor(100,
+                                  [&](std::size_t i, int) {
+                                    calls.fetch_add(1);
+                                    if (i == 7) throw std::runtime_error("index 7");
+                                  }),
                  std::runtime_error);
     EXPECT_GE(calls.load(), 8);
+    // The next loop runs whole, and an earlier loop's exception is not thrown again.
+    std::atomic<int> after{0};
+    pool.ParallelFor(100, [&](std::size_t, int) { after.fetch_add(1); });
+    EXPECT_EQ(after.load(), 100);
   }
 }
 

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <limits>
 #include <random>
+#include <string>
 
 #include "base/angle.h"
 #include "base/pose.h"
@@ -263,6 +264,82 @@ TEST(PreprocessTest, SinglePrecisionCompensationStaysWithinItsToleranceOfDouble)
                 "per m of range (plane), %.2e (height)\n", sweep, worst, worst_height);
     EXPECT_LE(worst, kCompensationTolerance) << "sweep " << sweep;
     EXPECT_LE(worst_height, kCompensationTolerance) << "sweep " << sweep;
+  }
+}
+
+TEST(PreprocessTest, AnyNumberOfThreadsPlacesAndKeepsTheSameReturns) {
+  // A 64-ring sweep of 100,000 returns (enough for three threads to share), a turning ego, a
+  // sloped ground with boxes on it, and every kind of refused return sprinkled through: one
+  // thread's result, written return by return, is what any number of threads must give.
+  const PoseHistory poses = MakePoses(12.0, 0.6, 0.3);
+  LadarScan scan;
+  scan.utime = kT0 + 50'000;
+  scan.sweep_duration_us = 100'000;
+  scan.num_rings = 64;
+  scan.max_range = 120.0f;
+  scan.body_from_sensor.translation() = Eigen::Vector3d(0.3, 0.0, 1.7);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> ang(-kPi, kPi), range(1.5, 90.0), unit(0.0, 1.0);
+  std::uniform_int_distribution<int> ring(0, 63), dt(0, 100'000);
+  for (int i = 0; i < 100'000; ++i) {
+    const double a = ang(rng), r = range(rng);
+    const double bx = r * std::cos(a), by = r * std::sin(a);
+    // Road sloping 2 % along x, and a box 0.3-2 m high in one return of five.
+    const double height = 0.02 * bx + (unit(rng) < 0.2 ? 0.3 + 1.7 * unit(rng) : 0.0);
+    float x = static_cast<float>(bx), y = static_cast<float>(by);
+    std::int16_t rg = static_cast<std::int16_t>(ring(rng));
+    std::int32_t t = dt(rng);
+    const double bad = unit(rng);
+    if (bad < 0.002) x = std::numeric_limits<float>::quiet_NaN();
+    else if (bad < 0.004) y = 1e30f;  // far
+    else if (bad < 0.006) rg = 70;    // bad ring
+    else if (bad < 0.008) t = -3;     // bad time
+    scan.x.push_back(x);
+    scan.y.push_back(y);
+    scan.z.push_back(static_cast<float>(height - 1.7));
+    scan.intensity.push_back(0.0f);
+    scan.ring.push_back(rg);
+    scan.dt_us.push_back(t);
+  }
+  auto run = [&](int threads, PreprocessResult* res) {
+    WorkerPool pool(threads);
+    Preprocessor pre(PreprocessParams{});
+    pre.SetPool(&pool);
+    WorldPoints out;
+    *res = pre.Run(scan, poses, 0, &out);
+    // A second sweep through the same preprocessor: its buffers from the first must not show.
+    *res = pre.Run(scan, poses, 0, &out);
+    return out;
+  };
+  PreprocessResult one_res;
+  const WorldPoints one = run(1, &one_res);
+  ASSERT_EQ(one_res.status, CompensationStatus::kOk);
+  // The scene exercises every path: refusals of each reason, ground removed, returns kept.
+  EXPECT_GT(one_res.stats.nonfinite, 100);
+  EXPECT_GT(one_res.stats.far, 100);
+  EXPECT_GT(one_res.stats.bad_ring, 100);
+  EXPECT_GT(one_res.stats.bad_time, 100);
+  EXPECT_GT(one_res.stats.ground, 50'000);
+  EXPECT_GT(one.size(), 10'000u);
+  for (const int threads : {2, 3}) {
+    SCOPED_TRACE("threads " + std::to_string(threads));
+    PreprocessResult res;
+    const WorldPoints many = run(threads, &res);
+    EXPECT_EQ(res.stats.input, one_res.stats.input);
+    EXPECT_EQ(res.stats.nonfinite, one_res.stats.nonfinite);
+    EXPECT_EQ(res.stats.far, one_res.stats.far);
+    EXPECT_EQ(res.stats.bad_ring, one_res.stats.bad_ring);
+    EXPECT_EQ(res.stats.bad_time, one_res.stats.bad_time);
+    EXPECT_EQ(res.stats.out_of_range, one_res.stats.out_of_range);
+    EXPECT_EQ(res.stats.ground, one_res.stats.ground);
+    EXPECT_EQ(res.stats.kept, one_res.stats.kept);
+    // Bit for bit, element by element.
+    EXPECT_EQ(many.x, one.x);
+    EXPECT_EQ(many.y, one.y);
+    EXPECT_EQ(many.height, one.height);
+    EXPECT_EQ(many.index, one.index);
+    EXPECT_EQ(many.ring, one.ring);
+    EXPECT_EQ(many.column_top, one.column_top);
   }
 }
 

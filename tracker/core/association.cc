@@ -76,9 +76,9 @@ Associator::Associator(const AssociationParams& params) : params_(params) {}
 
 namespace {
 
-// Fewer tracks than this per thread have their candidate pairs found on the calling thread:
-// starting a loop on the pool costs some 10-50 us, the pairs of about 30 tracks of a KITTI
-// sweep.
+// The candidate pairs of fewer than twice this many tracks are found on the calling thread: a
+// loop on the pool costs the wake-up of its threads (a few us, at times 100 us or more on a busy
+// machine), the pairs of some 30 tracks of a KITTI sweep.
 constexpr std::size_t kMinTracksPerThread = 32;  // [tracks]
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <exception>
 #include <mutex>
+#include <stdexcept>
 #include <thread>
 #include <type_traits>
 #include <vector>
@@ -26,31 +27,39 @@ class WorkerPool {
  public:
   // threads: the calling thread (worker 0) and threads - 1 started here (workers 1 ...); 1 or
   // less: every loop runs on the calling thread.
+  // If a thread cannot be started, those started are stopped and the error is thrown.
   explicit WorkerPool(int threads) {
     const int started = std::max(threads, 1) - 1;
     threads_.reserve(static_cast<std::size_t>(started));
-    for (int w = 1; w <= started; ++w) threads_.emplace_back([this, w] { Serve(w); });
-  }
-  ~WorkerPool() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      stop_ = true;
+    try {
+      for (int w = 1; w <= started; ++w) threads_.emplace_back([this, w] { Serve(w); });
+    } catch (...) {
+      Stop();
+      throw;
     }
-    wake_.notify_all();
-    for (std::thread& t : threads_) t.join();
   }
+  ~WorkerPool() { Stop(); }
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
 
   int threads() const { return static_cast<int>(threads_.size()) + 1; }
 
   // Calls fn(i, worker) once for every i in [0, n); each worker takes the next index from a
-  // shared counter as it finishes one. worker (in [0, threads())) lets fn use per-thread
-  // scratch; fn must not touch what another index's call touches. Returns when every call has
-  // returned; the first exception a call threw is rethrown here (after the others have
-  // finished). One loop at a time: not to be called from two threads at once, nor from fn.
+  // shared counter as it finishes one, so which worker runs which index is not fixed. worker (in
+  // [0, threads())) lets fn use per-thread scratch; fn must not touch what another index's call
+  // touches. Returns when every call has returned. If calls threw, one of their exceptions (that
+  // of the lowest-numbered worker that threw) is rethrown here, after the others have finished;
+  // the workers stop taking indices once one has thrown. One loop at a time: a call from within
+  // fn, or from another thread while a loop runs, throws std::logic_error.
   template <class Fn>
   void ParallelFor(std::size_t n, Fn&& fn) {
+    if (running_.exchange(true)) {
+      throw std::logic_error("WorkerPool::ParallelFor called while one of its loops runs");
+    }
+    struct Done {
+      std::atomic<bool>* running;
+      ~Done() { running->store(false); }
+    } done{&running_};
     if (threads_.empty() || n <= 1) {
       for (std::size_t i = 0; i < n; ++i) fn(i, 0);
       return;
@@ -100,6 +109,15 @@ class WorkerPool {
     }
   }
 
+  void Stop() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    for (std::thread& t : threads_) t.join();
+  }
+
   void Serve(int worker) {
     std::uint64_t seen = 0;
     for (;;) {
@@ -128,6 +146,7 @@ class WorkerPool {
   std::size_t busy_ = 0;            // started workers not done with it (guarded by mutex_)
   std::uint64_t generation_ = 0;    // loops started so far (guarded by mutex_)
   bool stop_ = false;               // guarded by mutex_
+  std::atomic<bool> running_{false};  // a ParallelFor call is under way
   std::vector<std::exception_ptr> errors_;  // per worker: what its call threw, for the caller
 };
 

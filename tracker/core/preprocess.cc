@@ -43,8 +43,9 @@ Preprocessor::Preprocessor(const PreprocessParams& params) : params_(params) {}
 
 namespace {
 
-// Fewer returns than this per thread are placed (and binned) on the calling thread: starting a
-// thread and joining it costs some 20-50 us, the time of placing about 10,000 returns.
+// Fewer returns than this per thread are placed (and binned) on the calling thread: a loop on
+// the pool costs the wake-up of its threads (a few us, at times 100 us or more on a busy
+// machine), the time of placing some 10,000 returns at its worst.
 constexpr std::size_t kMinReturnsPerThread = 16384;  // [returns]
 
 // How many threads of pool (none: the calling one) to share n returns among.

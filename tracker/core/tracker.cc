@@ -169,8 +169,9 @@ bool Tracker::Process(const LadarScan& scan, bool extrapolate, ScanOutput* out) 
   out->utime = scan.utime;
   out->seq = scan.seq;
   out->stats = pre.stats;
-  // The scan's range profile (read by the updates) is built on a second thread while this one
-  // segments: both only read the returns, and each writes its own result.
+  // The scan's range profile (read by the updates) and its segmentation, two tasks for the pool
+  // (on two threads if the second is free, else one after the other): both only read the
+  // returns, and each writes its own result.
   pool_->ParallelFor(2, [&](std::size_t task, int) {
     if (task == 1) {
       BuildProfile(scan, pre.sensor_xy);

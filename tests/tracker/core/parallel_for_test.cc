@@ -1,6 +1,7 @@
 // WorkerPool: every index is called exactly once whatever the number of threads, loop after loop
 // on the same pool, the calls do run on more than one thread when asked, and an exception of one
-// call reaches the caller and leaves the pool usable.
+// call reaches the caller and leaves the pool usable, and a loop started from within a loop is
+// refused.
 #include "tracker/core/parallel_for.h"
 
 #include <gtest/gtest.h>
@@ -75,6 +76,19 @@ TEST(WorkerPool, AnExceptionOfOneCallReachesTheCallerAndThePoolGoesOn) {
     std::atomic<int> after{0};
     pool.ParallelFor(100, [&](std::size_t, int) { after.fetch_add(1); });
     EXPECT_EQ(after.load(), 100);
+  }
+}
+
+TEST(WorkerPool, ALoopStartedFromWithinALoopIsRefused) {
+  // Whatever the number of threads (with one the nested loop would run, with two it would
+  // corrupt the running one): the nested call throws, and that reaches the outer caller.
+  for (const int threads : {1, 2}) {
+    WorkerPool pool(threads);
+    EXPECT_THROW(pool.ParallelFor(4, [&](std::size_t, int) { pool.ParallelFor(2, [](std::size_t, int) {}); }),
+                 std::logic_error);
+    std::atomic<int> after{0};
+    pool.ParallelFor(10, [&](std::size_t, int) { after.fetch_add(1); });
+    EXPECT_EQ(after.load(), 10);
   }
 }
 

@@ -81,6 +81,10 @@ namespace {
 // machine), the pairs of some 30 tracks of a KITTI sweep.
 constexpr std::size_t kMinTracksPerThread = 32;  // [tracks]
 
+// The parts of fewer than twice this many segments are built on the calling thread (a KITTI
+// sweep has about 1,000; a single-plane scan a few dozen).
+constexpr std::size_t kMinSegmentsPerBlock = 64;  // [segments]
+
 }  // namespace
 
 double Associator::GateMargin(const PredictedObject& t) const {
@@ -186,67 +190,72 @@ void Associator::IndexClaimingGates(const std::vector<PredictedObject>& tracks) 
 }
 
 void Associator::ClaimingTracks(const Segment& s, const WorldPoints& pts,
-                                const Segments& segments, std::vector<std::size_t>* claim) {
+                                const Segments& segments, Scratch* scratch) const {
   // Established tracks with at least split_min_points of this segment's returns inside their
   // gate, in track order.
-  claim->clear();
-  sorted_.Overlapping(s.min, s.max, &candidates_);
+  std::vector<std::size_t>& claim = scratch->claim;
+  claim.clear();
+  sorted_.Overlapping(s.min, s.max, &scratch->candidates);
   const std::int32_t* const point = segments.point.data();
-  for (const std::int32_t jj : candidates_) {
+  for (const std::int32_t jj : scratch->candidates) {
     const auto j = static_cast<std::size_t>(jj);
     // Counted up to split_min_points (all the claim needs).
     const int inside = internal::CountInside(gates_[j], point + s.begin,
                                              static_cast<std::size_t>(s.end - s.begin),
                                              pts.x.data(), pts.y.data(), params_.split_min_points);
-    if (inside >= params_.split_min_points) claim->push_back(j);
+    if (inside >= params_.split_min_points) claim.push_back(j);
   }
 }
 
-void Associator::SplitAmong(const std::vector<PredictedObject>& tracks,
-                            const std::vector<std::size_t>& claim, const WorldPoints& pts,
-                            const std::int32_t* begin, const std::int32_t* end, std::size_t first) {
+void Associator::SplitAmong(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
+                            const std::int32_t* begin, const std::int32_t* end, Scratch* scratch,
+                            Part* parts) const {
   // Each return goes to the claimant it is nearest to, ordered by the signed distance to the
   // rectangle boundary (> 0 outside, <= 0 inside): the distance inside, its square outside.
   // Most segments of a KITTI scan are claimed by two or more tracks (clutter tracks on
   // vegetation and walls overlap): the claimants' frames side by side.
-  claimants_.clear();
-  for (const std::size_t j : claim) {
+  std::vector<RectFrame>& claimants = scratch->claimants;
+  claimants.clear();
+  for (const std::size_t j : scratch->claim) {
     const RectFrame& g = gates_[j];
-    claimants_.push_back({g.cx, g.cy, g.ax, g.ay, 0.5 * tracks[j].box.length,
-                          0.5 * tracks[j].box.width});
+    claimants.push_back({g.cx, g.cy, g.ax, g.ay, 0.5 * tracks[j].box.length,
+                         0.5 * tracks[j].box.width});
   }
   // Claimant by claimant over the returns gathered side by side (an odd count padded with a
   // copy of the last return, whose answer is not used): each return still meets the claimants
   // in order and keeps the first of the nearest.
   const auto n = static_cast<std::size_t>(end - begin);
   const std::size_t padded = n + (n & 1);
-  split_x_.resize(padded);
-  split_y_.resize(padded);
-  split_d_.assign(padded, kInf);
-  split_best_.assign(padded, 0);
+  std::vector<double>& x = scratch->split_x;
+  std::vector<double>& y = scratch->split_y;
+  x.resize(padded);
+  y.resize(padded);
+  scratch->split_d.assign(padded, kInf);
+  scratch->split_best.assign(padded, 0);
   for (std::size_t k = 0; k < n; ++k) {
-    split_x_[k] = pts.x[static_cast<std::size_t>(begin[k])];
-    split_y_[k] = pts.y[static_cast<std::size_t>(begin[k])];
+    x[k] = pts.x[static_cast<std::size_t>(begin[k])];
+    y[k] = pts.y[static_cast<std::size_t>(begin[k])];
   }
   if (padded > n) {
-    split_x_[n] = split_x_[n - 1];
-    split_y_[n] = split_y_[n - 1];
+    x[n] = x[n - 1];
+    y[n] = y[n - 1];
   }
-  for (std::size_t c = 0; c < claimants_.size(); ++c) {
-    internal::KeepNearer(claimants_[c], static_cast<std::int64_t>(c), padded, split_x_.data(),
-                         split_y_.data(), split_d_.data(), split_best_.data());
+  for (std::size_t c = 0; c < claimants.size(); ++c) {
+    internal::KeepNearer(claimants[c], static_cast<std::int64_t>(c), padded, x.data(), y.data(),
+                         scratch->split_d.data(), scratch->split_best.data());
   }
   for (std::size_t k = 0; k < n; ++k) {
-    parts_[first + static_cast<std::size_t>(split_best_[k])].points.push_back(begin[k]);
+    parts[static_cast<std::size_t>(scratch->split_best[k])].points.push_back(begin[k]);
   }
 }
 
-std::size_t Associator::BoundParts(const WorldPoints& pts, std::size_t first, bool split) {
+std::size_t Associator::BoundParts(const WorldPoints& pts, std::size_t first, std::size_t end,
+                                   bool split, std::vector<Part>* parts) const {
   // Bounding boxes; drops pieces of a split that are too small to fit (their buffers are kept
   // for reuse: swapped, not moved, to the end). Returns the new end of the parts in use.
   std::size_t w = first;
-  for (std::size_t q = first; q < num_parts_; ++q) {
-    Part& part = parts_[q];
+  for (std::size_t q = first; q < end; ++q) {
+    Part& part = (*parts)[q];
     if (split && static_cast<int>(part.points.size()) < params_.split_min_points) continue;
     part.min = Eigen::Vector2d::Constant(kInf);
     part.max = -part.min;
@@ -256,38 +265,82 @@ std::size_t Associator::BoundParts(const WorldPoints& pts, std::size_t first, bo
       part.max = part.max.cwiseMax(p);
     }
     if (w != q) {
-      std::swap(parts_[w].points, part.points);
-      parts_[w].min = part.min;
-      parts_[w].max = part.max;
+      std::swap((*parts)[w].points, part.points);
+      (*parts)[w].min = part.min;
+      (*parts)[w].max = part.max;
     }
     ++w;
   }
   return w;
 }
 
+std::size_t Associator::PartsOf(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
+                                const Segments& segments, std::size_t seg_begin,
+                                std::size_t seg_end, Scratch* scratch,
+                                std::vector<Part>* parts) const {
+  std::size_t used = 0;
+  for (std::size_t k = seg_begin; k < seg_end; ++k) {
+    const Segment& s = segments.segments[k];
+    ClaimingTracks(s, pts, segments, scratch);
+    const std::size_t first = used;
+    const std::size_t num_parts = scratch->claim.size() >= 2 ? scratch->claim.size() : 1;
+    if (parts->size() < first + num_parts) parts->resize(first + num_parts);
+    for (std::size_t q = first; q < first + num_parts; ++q) (*parts)[q].points.clear();
+    const std::int32_t* seg_begin_point = segments.point.data() + s.begin;
+    const std::int32_t* seg_end_point = segments.point.data() + s.end;
+    if (num_parts == 1) {
+      (*parts)[first].points.assign(seg_begin_point, seg_end_point);
+    } else {
+      SplitAmong(tracks, pts, seg_begin_point, seg_end_point, scratch, parts->data() + first);
+    }
+    used = BoundParts(pts, first, first + num_parts, num_parts > 1, parts);
+  }
+  return used;
+}
+
 void Associator::BuildParts(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
                             const Segments& segments) {
-  num_parts_ = 0;
+  // Segments in blocks, each block's parts gathered apart (the first block's in parts_) and
+  // appended in block order: the parts, in the order, of one pass over the segments. More
+  // blocks than threads: segments differ in size by thousands of returns.
+  const std::size_t ns = segments.segments.size();
+  const int threads = pool_ != nullptr ? pool_->threads() : 1;
+  const std::size_t blocks =
+      threads > 1 && ns >= 2 * kMinSegmentsPerBlock
+          ? std::min<std::size_t>(ns / kMinSegmentsPerBlock, 4 * static_cast<std::size_t>(threads))
+          : 1;
+  block_parts_.resize(blocks - 1);
+  block_num_parts_.assign(blocks, 0);
   std::size_t retained = 0;
   for (const Part& part : parts_) retained += part.points.capacity();
-  if (retained > 2 * segments.point.size() + kRetainedSlack) parts_.clear();
+  for (const std::vector<Part>& block : block_parts_) {
+    for (const Part& part : block) retained += part.points.capacity();
+  }
+  if (retained > 2 * segments.point.size() + kRetainedSlack) {
+    parts_.clear();
+    for (std::vector<Part>& block : block_parts_) block.clear();
+  }
   IndexClaimingGates(tracks);
-  std::vector<std::size_t> claim;
-  for (const Segment& s : segments.segments) {
-    ClaimingTracks(s, pts, segments, &claim);
-    const std::size_t first = num_parts_;
-    const std::size_t num_parts = claim.size() >= 2 ? claim.size() : 1;
-    if (parts_.size() < first + num_parts) parts_.resize(first + num_parts);
-    for (std::size_t q = first; q < first + num_parts; ++q) parts_[q].points.clear();
-    num_parts_ = first + num_parts;
-    const std::int32_t* seg_begin = segments.point.data() + s.begin;
-    const std::int32_t* seg_end = segments.point.data() + s.end;
-    if (num_parts == 1) {
-      parts_[first].points.assign(seg_begin, seg_end);
-    } else {
-      SplitAmong(tracks, claim, pts, seg_begin, seg_end, first);
+  scratch_.resize(static_cast<std::size_t>(threads));
+  const auto parts_of_block = [&](std::size_t b, int worker) {
+    block_num_parts_[b] = PartsOf(tracks, pts, segments, ns * b / blocks, ns * (b + 1) / blocks,
+                                  &scratch_[static_cast<std::size_t>(worker)],
+                                  b == 0 ? &parts_ : &block_parts_[b - 1]);
+  };
+  if (blocks == 1) {
+    parts_of_block(0, 0);
+  } else {
+    pool_->ParallelFor(blocks, parts_of_block);
+  }
+  num_parts_ = block_num_parts_[0];
+  for (std::size_t b = 1; b < blocks; ++b) {
+    std::vector<Part>& block = block_parts_[b - 1];
+    if (parts_.size() < num_parts_ + block_num_parts_[b]) parts_.resize(num_parts_ + block_num_parts_[b]);
+    for (std::size_t q = 0; q < block_num_parts_[b]; ++q, ++num_parts_) {
+      std::swap(parts_[num_parts_].points, block[q].points);  // buffers swapped, kept for reuse
+      parts_[num_parts_].min = block[q].min;
+      parts_[num_parts_].max = block[q].max;
     }
-    num_parts_ = BoundParts(pts, first, num_parts > 1);
   }
 }
 
@@ -376,10 +429,10 @@ void Associator::CandidatePairs(const std::vector<PredictedObject>& tracks, cons
   const std::size_t nt = tracks.size();
   const int blocks = pool_ != nullptr && nt >= 2 * kMinTracksPerThread ? pool_->threads() : 1;
   block_pairs_.resize(static_cast<std::size_t>(blocks) - 1);
-  block_candidates_.resize(static_cast<std::size_t>(blocks) - 1);
-  const auto pairs_of_block = [&](std::size_t b, int) {
+  scratch_.resize(static_cast<std::size_t>(pool_ != nullptr ? pool_->threads() : 1));
+  const auto pairs_of_block = [&](std::size_t b, int worker) {
     std::vector<Pair>& block = b == 0 ? *pairs : block_pairs_[b - 1];
-    std::vector<std::int32_t>& candidates = b == 0 ? candidates_ : block_candidates_[b - 1];
+    std::vector<std::int32_t>& candidates = scratch_[static_cast<std::size_t>(worker)].candidates;
     block.clear();
     Eigen::Vector2d lo, hi;
     const std::size_t end = nt * (b + 1) / static_cast<std::size_t>(blocks);

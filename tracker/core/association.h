@@ -130,13 +130,30 @@ class Associator {
   // between them.
   void BuildParts(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
                   const Segments& segments);
+  // What one thread of BuildParts and CandidatePairs works with (reused from scan to scan).
+  struct Scratch {
+    std::vector<std::int32_t> candidates;  // gates (or parts) overlapping a box
+    std::vector<std::size_t> claim;        // the tracks claiming one segment
+    std::vector<RectFrame> claimants;      // their rectangles
+    std::vector<double> split_x, split_y;  // split: the segment's returns side by side
+    std::vector<double> split_d;           // split: per return, its distance to the nearest claimant
+    std::vector<std::int64_t> split_best;  // split: per return, that claimant
+  };
   void IndexClaimingGates(const std::vector<PredictedObject>& tracks);
+  // The parts of segments [seg_begin, seg_end), in segment order, into (*parts)[0, returned
+  // count); the other elements of *parts keep their buffers.
+  std::size_t PartsOf(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
+                      const Segments& segments, std::size_t seg_begin, std::size_t seg_end,
+                      Scratch* scratch, std::vector<Part>* parts) const;
   void ClaimingTracks(const Segment& s, const WorldPoints& pts, const Segments& segments,
-                      std::vector<std::size_t>* claim);
-  void SplitAmong(const std::vector<PredictedObject>& tracks, const std::vector<std::size_t>& claim,
-                  const WorldPoints& pts, const std::int32_t* begin, const std::int32_t* end,
-                  std::size_t first);
-  std::size_t BoundParts(const WorldPoints& pts, std::size_t first, bool split);
+                      Scratch* scratch) const;
+  void SplitAmong(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
+                  const std::int32_t* begin, const std::int32_t* end, Scratch* scratch,
+                  Part* parts) const;
+  // Bounding boxes of parts [first, end); drops pieces of a split too small to fit. Returns the
+  // new end.
+  std::size_t BoundParts(const WorldPoints& pts, std::size_t first, std::size_t end, bool split,
+                         std::vector<Part>* parts) const;
   // Candidate pairs with their costs, in (track, part) order.
   void CandidatePairs(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
                       const Eigen::Vector2d& sensor_xy, std::vector<Pair>* pairs);
@@ -168,16 +185,14 @@ class Associator {
   std::vector<Part> parts_;                // [0, num_parts_) in use; the rest keep their buffers
   std::size_t num_parts_ = 0;
   SortedBoxes sorted_;
-  std::vector<std::int32_t> candidates_;
   std::vector<RectFrame> gates_;           // per track: frame, half sizes grown by its gate
-  std::vector<RectFrame> claimants_;       // the tracks claiming one segment
-  std::vector<double> split_x_, split_y_;  // split: the segment's returns side by side
-  std::vector<double> split_d_;            // split: per return, its distance to the nearest claimant
-  std::vector<std::int64_t> split_best_;   // split: per return, that claimant
+  std::vector<Scratch> scratch_;           // per thread of the pool (one without)
+  // Parts: per block of segments but the first (which writes parts_), its parts and their count.
+  std::vector<std::vector<Part>> block_parts_;
+  std::vector<std::size_t> block_num_parts_;
   std::vector<Pair> pairs_;
-  // Candidate pairs: per block of tracks but the first, its pairs and its gate's candidates.
+  // Candidate pairs: per block of tracks but the first, its pairs.
   std::vector<std::vector<Pair>> block_pairs_;
-  std::vector<std::vector<std::int32_t>> block_candidates_;
   std::vector<int> row_of_, col_of_;       // assignment: track -> row, part -> column
   std::vector<double> cost_;               // assignment: cost matrix, row-major
   std::vector<char> own_valid_;            // merge: own_lo_/own_hi_ of a track are current

@@ -382,12 +382,13 @@ TEST(AssociatorTest, SideOfALongMoverSeenEdgeOnJoinsIt) {
 }
 
 TEST(AssociatorTest, AnyNumberOfThreadsGivesTheSameAssociation) {
-  // A car park of 160 cars in ten rows 4 m apart, five either side of the sensor (neighbours'
-  // gates overlap, so tracks compete for parts), tracked by 150 tracks predicted up to 0.6 m off
-  // (ten cars are new, a few tracks tentative); some pairs of neighbours in one segment (split
+  // A car park of 400 cars in 25 rows 4 m apart, either side of the sensor (neighbours' gates
+  // overlap, so tracks compete for parts), tracked by 375 tracks predicted up to 0.6 m off
+  // (25 cars are new, a few tracks tentative); some pairs of neighbours in one segment (split
   // between their tracks), some cars cut in two segments (one merged into the track that takes
-  // the other): enough tracks for the candidate pairs to be shared among threads. One thread's
-  // result is what any number of threads must give. (The order of the pairs is not seen here:
+  // the other): enough segments and tracks for the parts and the candidate pairs to be shared
+  // among threads in several blocks. One thread's result is what any number of threads must
+  // give. (The order of the pairs is not seen here:
   // the assignment depends on it only at exact ties. The TRACKS digests of KITTI 0000, 238
   // tracks a scan, are the check of the whole with two threads.)
   const Eigen::Vector2d sensor(0, 0);
@@ -396,7 +397,7 @@ TEST(AssociatorTest, AnyNumberOfThreadsGivesTheSameAssociation) {
   WorldPoints pts;
   std::vector<std::pair<int, int>> ranges;
   std::vector<PredictedObject> tracks;
-  for (int k = 0; k < 160; ++k) {
+  for (int k = 0; k < 400; ++k) {
     const int row = k / 16;
     const double x = -50.0 + 6.5 * (k % 16);
     const double y = (row % 2 == 0 ? 1.0 : -1.0) * (5.0 + 4.0 * (row / 2));
@@ -429,7 +430,7 @@ TEST(AssociatorTest, AnyNumberOfThreadsGivesTheSameAssociation) {
   ASSERT_EQ(one.track_points.size(), tracks.size());
   std::size_t assigned = 0;
   for (const auto& idx : one.track_points) assigned += idx.empty() ? 0 : 1;
-  EXPECT_GT(assigned, 120u);
+  EXPECT_GT(assigned, 300u);
   EXPECT_GT(one.num_split, 0);
   EXPECT_GT(one.num_merged, 0);
   EXPECT_FALSE(one.new_objects.empty());

@@ -325,16 +325,16 @@ namespace {
 // distance of the sensor, where most cells see the road.
 constexpr double kGroundLevelRadius = 20.0;  // [m]
 
-// Keeps the returns whose height above the ground (ground_of(i, height)) lies in
-// [min_h, max_h], storing that height; counts the others as ground. column(i, h) is called for
-// each return at least min_h high (kept or above max_h); cells (if not null) is compacted like
-// the returns.
+// Keeps, of returns [begin, end) of *pts, those whose height above the ground (ground_of(i))
+// lies in [min_h, max_h], moved up to begin on in their order, with that height; column(i, h) is
+// called for each return at least min_h high (kept or above max_h); cells (if not null) is
+// moved like the returns. Returns the end of the kept ones.
 template <class GroundOf, class Column>
-void KeepAboveGround(double min_h, double max_h, GroundOf ground_of, Column column, WorldPoints* pts,
-                     std::vector<std::int32_t>* cells, PreprocessStats* stats) {
-  const std::size_t n = pts->size();
-  std::size_t w = 0;
-  for (std::size_t i = 0; i < n; ++i) {
+std::size_t KeepAboveGround(double min_h, double max_h, GroundOf ground_of, Column column,
+                            std::size_t begin, std::size_t end, WorldPoints* pts,
+                            std::vector<std::int32_t>* cells) {
+  std::size_t w = begin;
+  for (std::size_t i = begin; i < end; ++i) {
     const float h = pts->height[i] - ground_of(i);
     if (h < min_h) continue;
     column(i, h);
@@ -347,12 +347,36 @@ void KeepAboveGround(double min_h, double max_h, GroundOf ground_of, Column colu
     if (cells != nullptr) (*cells)[w] = (*cells)[i];
     ++w;
   }
-  stats->ground = static_cast<std::int64_t>(n - w);
+  return w;
+}
+
+// Returns [begin[c], kept_end[c]) of each range c moved to follow those of the ranges before (in
+// order, forward: a range never moves past its own start), the arrays trimmed to them; cells (if
+// not null) moved alike. Returns how many are kept.
+std::size_t JoinKeptRanges(const std::vector<std::size_t>& begin,
+                           const std::vector<std::size_t>& kept_end, WorldPoints* pts,
+                           std::vector<std::int32_t>* cells) {
+  std::size_t w = kept_end.front();
+  for (std::size_t c = 1; c < begin.size(); ++c) {
+    const auto move = [&](auto& v) {
+      std::copy(v.begin() + static_cast<std::ptrdiff_t>(begin[c]),
+                v.begin() + static_cast<std::ptrdiff_t>(kept_end[c]),
+                v.begin() + static_cast<std::ptrdiff_t>(w));
+    };
+    move(pts->x);
+    move(pts->y);
+    move(pts->height);
+    move(pts->index);
+    move(pts->ring);
+    if (cells != nullptr) move(*cells);
+    w += kept_end[c] - begin[c];
+  }
   pts->x.resize(w);
   pts->y.resize(w);
   pts->height.resize(w);
   pts->index.resize(w);
   pts->ring.resize(w);
+  return w;
 }
 
 }  // namespace
@@ -360,8 +384,11 @@ void KeepAboveGround(double min_h, double max_h, GroundOf ground_of, Column colu
 void Preprocessor::RemoveGroundBand(WorldPoints* out, PreprocessStats* stats) const {
   // Heights above a flat ground at ground_height_body.
   const float ground = static_cast<float>(params_.ground_height_body);
-  KeepAboveGround(params_.min_height, params_.max_height, [ground](std::size_t) { return ground; },
-                  [](std::size_t, float) {}, out, nullptr, stats);
+  const std::size_t n = out->size();
+  const std::size_t kept = KeepAboveGround(
+      params_.min_height, params_.max_height, [ground](std::size_t) { return ground; },
+      [](std::size_t, float) {}, 0, n, out, nullptr);
+  stats->ground = static_cast<std::int64_t>(n - JoinKeptRanges({0}, {kept}, out, nullptr));
 }
 
 void Preprocessor::RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts,
@@ -374,26 +401,53 @@ void Preprocessor::RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts,
   BinLowestReturns(grid, *pts);
   BoundByGrade(grid);
   const float level = GroundLevel(grid);
-  cell_ground_.assign(static_cast<std::size_t>(grid.side) * grid.side,
-                      std::numeric_limits<float>::quiet_NaN());
+  // The ground of every cell holding a return (those with a lowest return; never on the grid's
+  // edge, where no return is binned).
+  const std::size_t num_cells = static_cast<std::size_t>(grid.side) * grid.side;
+  cell_ground_.assign(num_cells, std::numeric_limits<float>::quiet_NaN());
+  for (std::size_t c = 0; c < num_cells; ++c) {
+    if (cell_min_[c] < std::numeric_limits<float>::infinity()) {
+      CellGround(grid, static_cast<std::int32_t>(c), level);
+    }
+  }
+  // Returns in chunks, one per thread, each keeping its own within its range and the highest
+  // return of each cell in a grid of its own (the first: cell_top_), merged by the maximum; the
+  // ranges' kept returns then joined in order: what one pass would keep, where it would.
+  const std::size_t n = pts->size();
+  const int chunks = num_cells <= n ? ChunksFor(n, pool_) : 1;
   // Locals: the stores below could alias the parameters, which would be reloaded per return.
   const double min_h = params_.min_height, max_h = params_.max_height;
-  cell_top_.assign(cell_ground_.size(), 0.0f);
   const float* const ground = cell_ground_.data();
-  KeepAboveGround(
-      min_h, max_h,
-      [&](std::size_t i) {
-        // Computed once per cell, at its first return (NaN until then): the call only then.
-        const float g = ground[point_cell_[i]];
-        return std::isnan(g) ? CellGround(grid, point_cell_[i], level) : g;
-      },
-      [&](std::size_t i, float h) {
-        float& top = cell_top_[static_cast<std::size_t>(point_cell_[i])];
-        top = std::max(top, h);
-      },
-      pts, &point_cell_, stats);
+  const std::int32_t* const point_cell = point_cell_.data();
+  cell_top_.assign(num_cells, 0.0f);
+  worker_cell_top_.resize(static_cast<std::size_t>(chunks) - 1);
+  std::vector<std::size_t> begin(static_cast<std::size_t>(chunks)), kept_end(begin.size());
+  const auto keep = [&](std::size_t c, int) {
+    float* top = cell_top_.data();
+    if (c > 0) {
+      worker_cell_top_[c - 1].assign(num_cells, 0.0f);
+      top = worker_cell_top_[c - 1].data();
+    }
+    begin[c] = ChunkBegin(n, static_cast<int>(c), chunks);
+    kept_end[c] = KeepAboveGround(
+        min_h, max_h, [&](std::size_t i) { return ground[point_cell[i]]; },
+        [&](std::size_t i, float h) {
+          float& t = top[static_cast<std::size_t>(point_cell[i])];
+          t = std::max(t, h);
+        },
+        begin[c], ChunkBegin(n, static_cast<int>(c) + 1, chunks), pts, &point_cell_);
+  };
+  if (chunks == 1) {
+    keep(0, 0);
+  } else {
+    pool_->ParallelFor(static_cast<std::size_t>(chunks), keep);
+  }
+  for (const std::vector<float>& own : worker_cell_top_) {
+    for (std::size_t c = 0; c < num_cells; ++c) cell_top_[c] = std::max(cell_top_[c], own[c]);
+  }
+  const std::size_t kept = JoinKeptRanges(begin, kept_end, pts, &point_cell_);
+  stats->ground = static_cast<std::int64_t>(n - kept);
   // The top of each kept return's column: the highest return of its cell.
-  const std::size_t kept = pts->size();
   pts->column_top.resize(kept);
   for (std::size_t i = 0; i < kept; ++i) {
     pts->column_top[i] = cell_top_[static_cast<std::size_t>(point_cell_[i])];

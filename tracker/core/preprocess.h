@@ -136,7 +136,7 @@ class Preprocessor {
   void BinLowestReturns(const GroundGrid& grid, const WorldPoints& pts);
   void BoundByGrade(const GroundGrid& grid);
   float GroundLevel(const GroundGrid& grid) const;
-  // The ground of a cell, computed and stored in cell_ground_ (the caller looks there first).
+  // The ground of a cell, computed and stored in cell_ground_.
   float CellGround(const GroundGrid& grid, std::int32_t cell, float level);
   void RemoveGroundBand(WorldPoints* pts, PreprocessStats* stats) const;
 
@@ -156,6 +156,7 @@ class Preprocessor {
   // Ground grid.
   std::vector<float> cell_min_, cell_ground_, cell_bound_, cell_top_;
   std::vector<std::vector<float>> worker_cell_min_;  // per thread but the first: its cell_min_
+  std::vector<std::vector<float>> worker_cell_top_;  // per thread but the first: its cell_top_
   std::vector<std::int32_t> point_cell_;
 };
 

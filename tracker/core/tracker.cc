@@ -169,12 +169,13 @@ bool Tracker::Process(const LadarScan& scan, bool extrapolate, ScanOutput* out) 
   out->utime = scan.utime;
   out->seq = scan.seq;
   out->stats = pre.stats;
-  // The scan's range profile (read by the updates) and its segmentation, two tasks for the pool
-  // (on two threads if the second is free, else one after the other): both only read the
-  // returns, and each writes its own result.
+  // The scan's segmentation, and its range profile (read by the updates) with the tracks
+  // predicted to the middle of the sweep: two tasks for the pool (on two threads if the second
+  // is free, else one after the other). Each writes its own result; both read the returns.
   pool_->ParallelFor(2, [&](std::size_t task, int) {
     if (task == 1) {
       BuildProfile(scan, pre.sensor_xy);
+      manager_->Predict(scan.utime + scan.sweep_duration_us / 2, &predicted_);
       return;
     }
     // Segmentation, then the pieces of faces seen at a grazing angle joined.
@@ -182,8 +183,7 @@ bool Tracker::Process(const LadarScan& scan, bool extrapolate, ScanOutput* out) 
     JoinGrazingPieces(points_, pre.sensor_xy, params_.grazing, &segments_);
     IndexSegments();
   });
-  // Association with the tracks predicted to the middle of the sweep.
-  manager_->Predict(scan.utime + scan.sweep_duration_us / 2, &predicted_);
+  // Association with the predicted tracks.
   associator_.Run(predicted_, points_, segments_, pre.sensor_xy, &association_);
   out->num_segments = static_cast<std::int32_t>(segments_.segments.size());
   top_ring_ = TopRing(scan);

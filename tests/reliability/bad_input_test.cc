@@ -164,7 +164,7 @@ TEST_F(BadInputTest, RefusedMessagesAreCountedAndLeaveEveryTrackUnchanged) {
       h.intensity.assign(n, 0.0f); h.dt_us.assign(n, 0); h.ring.assign(n, 0);
       Send(node, "LADAR_SCAN", Encode(h));
     }
-    if (i == 11) {  // sweep out of range, mounting not a rotation, NaN mounting
+    if (i == 11) {  // sweep out of range, mounting not a rotation, NaN mounting, mounting 1e39 m up
       ladar_scan_t s = previous;
       s.utime = previous.utime + 3;
       s.sweep_duration_us = -5;
@@ -174,6 +174,9 @@ TEST_F(BadInputTest, RefusedMessagesAreCountedAndLeaveEveryTrackUnchanged) {
       Send(node, "LADAR_SCAN", Encode(s));
       s.sensor_orientation[0] = previous.sensor_orientation[0];
       s.sensor_pos[1] = std::numeric_limits<double>::quiet_NaN();
+      Send(node, "LADAR_SCAN", Encode(s));
+      s.sensor_pos[1] = previous.sensor_pos[1];
+      s.sensor_pos[2] = 1e39;  // finite, beyond a float
       Send(node, "LADAR_SCAN", Encode(s));
     }
     if (i == 14) {  // the previous scan again
@@ -217,7 +220,7 @@ TEST_F(BadInputTest, RefusedMessagesAreCountedAndLeaveEveryTrackUnchanged) {
   EXPECT_EQ(node->decode_errors(), 6);
   EXPECT_EQ(r["empty_scan"], 1);
   EXPECT_EQ(r["huge_scan"], 1);
-  EXPECT_EQ(r["bad_scan"], 3);
+  EXPECT_EQ(r["bad_scan"], 4);
   EXPECT_EQ(r["scan_repeated"], 1);
   EXPECT_EQ(r["scan_out_of_order"], 1);
   EXPECT_EQ(r["pose_repeated"], 1);
@@ -226,7 +229,7 @@ TEST_F(BadInputTest, RefusedMessagesAreCountedAndLeaveEveryTrackUnchanged) {
   EXPECT_EQ(r["scan_seq_gap"], 0);
   EXPECT_EQ(r["nan_point"], 0);
   EXPECT_EQ(node->tracker().resets(), 0);
-  EXPECT_EQ(node->tracker().scans_dropped(), 7);  // empty, huge, 3 bad, repeated, older
+  EXPECT_EQ(node->tracker().scans_dropped(), 8);  // empty, huge, 4 bad, repeated, older
   // The valid traffic around them: every TRACKS message as in the clean run, byte for byte.
   ASSERT_EQ(bad.utimes, clean.utimes);
   int differ = 0;

@@ -358,6 +358,10 @@ std::size_t JoinKeptRanges(const std::vector<std::size_t>& begin,
                            std::vector<std::int32_t>* cells) {
   std::size_t w = kept_end.front();
   for (std::size_t c = 1; c < begin.size(); ++c) {
+    if (w == begin[c]) {  // nothing dropped before this range: already in place
+      w = kept_end[c];
+      continue;
+    }
     const auto move = [&](auto& v) {
       std::copy(v.begin() + static_cast<std::ptrdiff_t>(begin[c]),
                 v.begin() + static_cast<std::ptrdiff_t>(kept_end[c]),

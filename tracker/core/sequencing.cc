@@ -23,6 +23,11 @@ constexpr std::uint64_t kMaxSeqGap = 100'000;
 // return placed with the pose absurd and overflow the ground grid's cell arithmetic.
 constexpr double kMaxPoseCoordinate = 1e7;  // [m]
 
+// A sensor mounted farther than this from the body origin is refused: vehicles measure metres,
+// and a mounting height beyond a float's range (the returns' heights are computed in float)
+// would give every return an infinite height.
+constexpr double kMaxMountingOffset = 1000.0;  // [m]
+
 bool IsRotation(const Eigen::Matrix3d& R) {
   return (R.transpose() * R - Eigen::Matrix3d::Identity()).norm() <= kMaxRotationError;
 }
@@ -225,6 +230,10 @@ std::string ScanSequencer::CheckScan(const LadarScan& scan, const char** reason)
     return "max_range " + std::to_string(scan.max_range) + " is not finite or negative";
   }
   if (!scan.body_from_sensor.matrix().allFinite()) return "mounting pose is not finite";
+  if (scan.body_from_sensor.translation().norm() > kMaxMountingOffset) {
+    return "mounting position " + std::to_string(scan.body_from_sensor.translation().norm()) +
+           " m from the body origin (more than " + std::to_string(kMaxMountingOffset) + ")";
+  }
   if (!IsRotation(scan.body_from_sensor.linear())) return "mounting orientation is not a rotation";
   if (n == 0) {
     *reason = "empty_scan";

@@ -388,7 +388,7 @@ TEST(AssociatorTest, AnyNumberOfThreadsGivesTheSameAssociation) {
   // between their tracks), some cars cut in two segments (one merged into the track that takes
   // the other): enough segments and tracks for the parts and the candidate pairs to be shared
   // among threads in several blocks. One thread's result is what any number of threads must
-  // give. (The order of the pairs is not seen here:
+  // give, after a smaller scan through the same associator. (The order of the pairs is not seen here:
   // the assignment depends on it only at exact ties. The TRACKS digests of KITTI 0000, 238
   // tracks a scan, are the check of the whole with two threads.)
   const Eigen::Vector2d sensor(0, 0);
@@ -423,6 +423,14 @@ TEST(AssociatorTest, AnyNumberOfThreadsGivesTheSameAssociation) {
     Associator assoc(AssociationParams{});
     assoc.SetPool(&pool);
     AssociationResult res;
+    if (threads > 1) {
+      // A scan before, with a third of the segments and tracks (fewer blocks): what it leaves in
+      // the associator's buffers must not show in the next.
+      const std::size_t some_ranges = ranges.size() / 3;
+      const std::vector<std::pair<int, int>> first_ranges(ranges.begin(), ranges.begin() + static_cast<std::ptrdiff_t>(some_ranges));
+      const std::vector<PredictedObject> first_tracks(tracks.begin(), tracks.begin() + static_cast<std::ptrdiff_t>(tracks.size() / 3));
+      assoc.Run(first_tracks, pts, SegmentsOf(pts, first_ranges), sensor, &res);
+    }
     assoc.Run(tracks, pts, segs, sensor, &res);
     return res;
   };

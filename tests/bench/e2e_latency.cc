@@ -1,6 +1,13 @@
-// End-to-end latency of the live tracker over LCM: scan published on LADAR_SCAN -> its
+// End-to-end latency of the live tracker over LCM: a sweep's last return published -> its
 // track_list_t received on TRACKS, with the real vtrack-tracker process, full KITTI HDL-64E scans
-// (sequence 0000, 98k-124k returns, ~2.7 MB per message) at 10 Hz and ego poses at 100 Hz.
+// (sequence 0000, 98k-124k returns) at 10 Hz and ego poses at 100 Hz. Two ways to send a sweep:
+//   --slices 0     whole, one ladar_scan_t of ~2.7 MB on LADAR_SCAN at the sweep's end (LCM
+//                  sends it as 44 fragments; the tracker receives and decodes it all at once);
+//   --slices auto  as vtrack-ladar-driver sends a 64-beam sweep: azimuth slices of one datagram
+//                  each on LADAR_SLICE (45 for these scans), each published when its own last
+//                  return is measured (the scan's start plus the slice's largest dt_us), so the
+//                  slices of a sweep spread over its 100 ms and the last one closes it.
+// The latency runs from the publication of the last return (the whole scan, or the last slice).
 // The poses through each scan's last return time are published before the scan (as on a vehicle,
 // where the pose source runs ahead of the sweep), so the latency is decoding + tracking +
 // encoding + the bus, not waiting for poses. The first --warmup scans are not counted.
@@ -8,7 +15,7 @@
 // udpm only inside a private loopback-only network namespace (scripts/vtrack-netns); elsewhere
 // it exits 77 (skipped). Wall-clock times (steady clock) of this process.
 //
-//   scripts/vtrack-netns build/bench/e2e_latency --bin-dir build/bin [--scans 150] [--json F]
+//   scripts/vtrack-netns build/bench/e2e_latency --bin-dir build/bin [--scans 150] [--slices auto] [--json F]
 #include <lcm/lcm-cpp.hpp>
 
 #include <boost/program_options.hpp>
@@ -19,9 +26,11 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "lcmtypes/util/ladar_slices.h"
 #include "lcmtypes/util/process.h"
 #include "sensor_driver/kitti/kitti_sequence.h"
 #include "tests/bench/bench_data.h"
@@ -59,11 +68,11 @@ struct Receiver {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string bin_dir, kitti_dir = vtrack::bench::KittiDir(), json, url, log;
+  std::string bin_dir, kitti_dir = vtrack::bench::KittiDir(), json, url, log, slices_text = "0";
   int scans = 150, warmup = 10;
   double rate_hz = 10.0;
   po::options_description desc(
-      "e2e_latency: scan published -> TRACKS received, live vtrack-tracker over LCM (udpm, private "
+      "e2e_latency: a sweep published (whole or as slices) -> TRACKS received, live vtrack-tracker over LCM (udpm, private "
       "network namespace only)\nOptions");
   desc.add_options()("help,h", "show this help")(
       "bin-dir", po::value(&bin_dir)->required(), "directory holding vtrack-tracker")(
@@ -71,6 +80,9 @@ int main(int argc, char** argv) {
       "scans", po::value(&scans)->default_value(scans), "scans to publish (frames 1.., cycled)")(
       "warmup", po::value(&warmup)->default_value(warmup), "first scans not counted")(
       "rate-hz", po::value(&rate_hz)->default_value(rate_hz), "scan rate [Hz]")(
+      "slices", po::value(&slices_text)->default_value(slices_text),
+      "how each sweep is sent: 0 = whole on LADAR_SCAN; auto or N = N azimuth slices on "
+      "LADAR_SLICE, each when its last return is measured")(
       "lcm-url", po::value(&url)->default_value("udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608"),
       "LCM URL (udpm)")("tracker-log", po::value(&log)->default_value("/tmp/e2e_latency_tracker.log"),
                         "the tracker's stdout/stderr")("json", po::value(&json), "write the figures here");
@@ -78,6 +90,12 @@ int main(int argc, char** argv) {
   if (scans <= warmup || scans < 1 || warmup < 0 || !(rate_hz > 0.0 && rate_hz <= 100.0)) {
     std::cerr << "e2e_latency: need scans > warmup >= 0 and rate-hz in (0, 100]; got scans=" << scans
               << " warmup=" << warmup << " rate-hz=" << rate_hz << "\n";
+    return 2;
+  }
+  const std::optional<int> slices_option = vtrack::lcm_util::ParseSlicesOption(slices_text);
+  if (!slices_option) {
+    std::cerr << "e2e_latency: --slices must be auto, 0 or a count in [1, "
+              << vtrack::lcm_util::kMaxSlicesPerSweep << "]; got '" << slices_text << "'\n";
     return 2;
   }
   if (url.rfind("udpm://", 0) == 0 && !vtrack::lcm_util::InPrivateLoopbackNamespace()) {
@@ -91,12 +109,18 @@ int main(int argc, char** argv) {
   o.dir = kitti_dir;
   o.cache_dir = VTRACK_BINARY_DIR "/kitti_cache";
   std::vector<vtrack::ladar_scan_t> frames;
+  std::vector<std::vector<vtrack::ladar_slice_t>> frame_slices;  // per frame; empty: sent whole
   std::unique_ptr<vtrack::kitti::Sequence> seq;
   try {
     seq = std::make_unique<vtrack::kitti::Sequence>(o);
     const int n = std::min(seq->num_frames() - 1, scans);
     std::fprintf(stderr, "e2e_latency: reading %d KITTI frames\n", n);
     for (int i = 1; i <= n; ++i) frames.push_back(seq->Scan(i));
+    for (vtrack::ladar_scan_t& f : frames) {
+      const int count = vtrack::lcm_util::SlicesFor(*slices_option, f);
+      frame_slices.push_back(count == 0 ? std::vector<vtrack::ladar_slice_t>{}
+                                        : vtrack::lcm_util::SliceSweep(f, count));
+    }
   } catch (const std::exception& e) {
     std::cerr << "e2e_latency: KITTI data: " << e.what() << "\n";
     return 1;
@@ -134,6 +158,7 @@ int main(int argc, char** argv) {
   std::int64_t next_pose = seq->FirstPoseUtime() + 10'000;
   std::map<std::int64_t, Clock::time_point> published;
   std::vector<std::int64_t> counted;
+  long sliced_scans = 0, slices_sent = 0;
   auto tick = Clock::now();
   for (int k = 0; k < scans; ++k) {
     const std::size_t f = static_cast<std::size_t>(k) % frames.size();
@@ -149,8 +174,25 @@ int main(int argc, char** argv) {
       p.utime = next_pose;
       lcm.publish("EGO_POSE", &p);
     }
-    published[scan.utime] = Clock::now();
-    lcm.publish("LADAR_SCAN", &scan);
+    std::vector<vtrack::ladar_slice_t>& slices = frame_slices[f];
+    if (slices.empty()) {
+      published[scan.utime] = Clock::now();
+      lcm.publish("LADAR_SCAN", &scan);
+    } else {
+      // Each slice when its last return is measured, from the scan's start (this tick); TRACKS
+      // of the scan before are taken in the gaps.
+      for (vtrack::ladar_slice_t& slice : slices) {
+        const std::int32_t last_dt = slice.dt_us.empty() ? 0 : *std::max_element(slice.dt_us.begin(), slice.dt_us.end());
+        handle_until(tick + std::chrono::microseconds(last_dt));
+        slice.utime = scan.utime;
+        slice.seq = k;
+        published[scan.utime] = Clock::now();
+        lcm.publish("LADAR_SLICE", &slice);
+        slice.utime = orig_utime;
+      }
+      sliced_scans += 1;
+      slices_sent += static_cast<long>(slices.size());
+    }
     if (k >= warmup) counted.push_back(scan.utime);
     scan.utime = orig_utime;
     tick += std::chrono::microseconds(period_us);
@@ -177,18 +219,23 @@ int main(int argc, char** argv) {
   }
   const double med = vtrack::bench::Percentile(ms, 50), p99 = vtrack::bench::Percentile(ms, 99),
                mx = vtrack::bench::Percentile(ms, 100);
-  // The tracker's own latency_us: from its scan callback (message received and decoded) to
-  // publishing TRACKS; the rest is the bus (fragmentation, loopback, reassembly) and decoding.
+  // The tracker's own latency_us: from the sweep's arrival (the whole scan, or its last slice,
+  // received and decoded) to publishing TRACKS; the rest is the bus (fragmentation, loopback,
+  // reassembly) and decoding.
   const double proc_med = vtrack::bench::Percentile(proc, 50), proc_p99 = vtrack::bench::Percentile(proc, 99);
-  std::printf("e2e latency over LCM (%zu scans at %.0f Hz, %zu answered, %d lost): median %.2f ms, p99 %.2f ms, max %.2f ms; "
-              "in the tracker (callback to publish): median %.2f ms, p99 %.2f ms\n",
-              counted.size(), rate_hz, ms.size(), lost, med, p99, mx, proc_med, proc_p99);
+  const std::string sent =
+      sliced_scans == 0 ? std::string("whole scans on LADAR_SCAN")
+                        : std::to_string(slices_sent / sliced_scans) + " slices a scan on LADAR_SLICE";
+  std::printf("e2e latency over LCM (%zu scans at %.0f Hz, %s, %zu answered, %d lost): median %.2f ms, p99 %.2f ms, max %.2f ms; "
+              "in the tracker (last message received to publish): median %.2f ms, p99 %.2f ms\n",
+              counted.size(), rate_hz, sent.c_str(), ms.size(), lost, med, p99, mx, proc_med, proc_p99);
   if (!json.empty()) {
     std::ofstream os(json);
     os << "{\"e2e_latency_ms_median\": " << med << ", \"e2e_latency_ms_p99\": " << p99
        << ", \"e2e_latency_ms_max\": " << mx << ", \"e2e_tracker_ms_median\": " << proc_med
        << ", \"e2e_tracker_ms_p99\": " << proc_p99 << ", \"e2e_scans\": " << counted.size()
        << ", \"e2e_lost\": " << lost << ", \"e2e_rate_hz\": " << rate_hz
+       << ", \"e2e_slices_per_scan\": " << (sliced_scans == 0 ? 0 : slices_sent / sliced_scans)
        << ", \"tracker_exit_status\": " << status << "}\n";
   }
   return 0;

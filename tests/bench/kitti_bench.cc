@@ -11,6 +11,7 @@
 #include <memory>
 #include <string>
 
+#include "lcmtypes/util/ladar_slices.h"
 #include "sensor_driver/kitti/kitti_scan.h"
 #include "sensor_driver/kitti/kitti_sequence.h"
 
@@ -102,6 +103,32 @@ void BM_EncodeScan(benchmark::State& state) {
   state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(buf.size()));
 }
 BENCHMARK(BM_EncodeScan)->Unit(benchmark::kMillisecond);
+
+// A sweep put back together from its slices as the tracker receives them (SweepAssembler, the
+// slices of vtrack-ladar-driver's --slices auto): the work between a sweep's last slice arriving
+// and the tracker having the whole sweep. The copies of the slices handed in are made outside
+// the timed part.
+void BM_AssembleSweep(benchmark::State& state) {
+  const auto scan = vtrack::kitti::MakeScan(vtrack::kitti::ReadVelodyneBin(FramePath()), 1'000'000, 0, {});
+  const std::vector<vtrack::ladar_slice_t> slices = vtrack::lcm_util::SliceSweep(scan, 0);
+  vtrack::lcm_util::SweepAssembler assembler;
+  std::vector<vtrack::lcm_util::AssembledSweep> out;
+  std::int64_t seq = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    std::vector<vtrack::ladar_slice_t> copies = slices;
+    for (vtrack::ladar_slice_t& c : copies) c.seq = seq, c.utime += seq * 100'000;
+    ++seq;
+    out.clear();
+    state.ResumeTiming();
+    for (vtrack::ladar_slice_t& c : copies) assembler.Add(std::move(c), &out);
+    benchmark::DoNotOptimize(out.data());
+  }
+  if (out.size() != 1 || out[0].scan.npoints != scan.npoints) state.SkipWithError("the sweep was not put back whole");
+  state.counters["slices"] = static_cast<double>(slices.size());
+  state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(scan.getEncodedSize()));
+}
+BENCHMARK(BM_AssembleSweep)->Unit(benchmark::kMillisecond);
 
 // Real data only: labels are needed.
 void BM_GroundTruthWithPointCounts(benchmark::State& state) {

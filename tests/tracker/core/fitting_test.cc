@@ -291,6 +291,42 @@ TEST(Fitting, Figure3eValidCornerAccepted) {
   EXPECT_NEAR(std::abs(AngleDiff(fit.z.z(), DegToRad(45.0))), 0.0, 1e-3);
 }
 
+// The corner's rule at its limit: a short face holding just the returns a corner needs (at least
+// min_edge_inliers and min_second_edge_fraction of the total) makes a corner; one return fewer
+// and the long face alone is the fit.
+TEST(Fitting, ShortFaceWithJustEnoughReturnsStillMakesACorner) {
+  const Eigen::Vector2d sensor(0.0, -10.0);
+  const FitParams params;
+  auto fit_l = [&](int long_face, int short_face) {
+    std::vector<float> x, y;
+    for (int i = 1; i <= long_face; ++i) {  // along (1, 1) / sqrt(2) from the corner at the origin
+      x.push_back(static_cast<float>(0.1 * i / std::sqrt(2.0)));
+      y.push_back(static_cast<float>(0.1 * i / std::sqrt(2.0)));
+    }
+    for (int i = 1; i <= short_face; ++i) {  // along (-1, 1) / sqrt(2)
+      x.push_back(static_cast<float>(-0.1 * i / std::sqrt(2.0)));
+      y.push_back(static_cast<float>(0.1 * i / std::sqrt(2.0)));
+    }
+    FitRequest req;
+    req.x = x;
+    req.y = y;
+    req.sensor_xy = sensor;
+    req.range_sigma_m = 0.01;
+    SegmentFitter fitter(params);
+    return fitter.Fit(req);
+  };
+  for (const int long_face : {30, 45, 60}) {
+    // The fewest returns of the short face that the corner's rule takes.
+    int need = params.min_edge_inliers;
+    while (need < static_cast<int>(std::ceil(params.min_second_edge_fraction * (long_face + need)))) ++need;
+    const FitResult corner = fit_l(long_face, need);
+    ASSERT_EQ(corner.kind, FitKind::kCorner) << long_face << " + " << need << ": " << ToString(corner.failure);
+    EXPECT_LT(corner.corner.norm(), 0.05);
+    const FitResult edge = fit_l(long_face, need - 1);
+    EXPECT_EQ(edge.kind, FitKind::kEdge) << long_face << " + " << need - 1 << ": " << ToString(edge.failure);
+  }
+}
+
 // ---------------------------------------------------------------- accuracy on synthetic scans
 
 struct ErrorStats {

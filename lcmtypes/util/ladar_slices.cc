@@ -375,10 +375,22 @@ void SweepAssembler::HandOn(std::map<Key, Pending>::iterator it, std::vector<Ass
   a.slice_count = static_cast<std::int32_t>(p.slices.size());
   a.slices_received = p.received;
   std::vector<AzimuthArc> covered;
+  // Each array allocated once at its final size: grown slice by slice it was copied and
+  // reallocated a dozen times, and fresh pages fault on first touch.
+  std::size_t total = 0;
+  for (const ladar_slice_t& s : p.slices) total += s.npoints >= 0 ? s.x.size() : 0;
   bool first = true;
   for (ladar_slice_t& s : p.slices) {
     if (s.npoints < 0) continue;
-    if (first) a.scan = ScanHeader(s);
+    if (first) {
+      a.scan = ScanHeader(s);
+      a.scan.x.reserve(total);
+      a.scan.y.reserve(total);
+      a.scan.z.reserve(total);
+      a.scan.intensity.reserve(total);
+      a.scan.dt_us.reserve(total);
+      a.scan.ring.reserve(total);
+    }
     first = false;
     covered.push_back({s.azimuth_begin, s.azimuth_end});
     Append(s.x, &a.scan.x);

@@ -3,10 +3,12 @@
 // (sequence 0000, 98k-124k returns) at 10 Hz and ego poses at 100 Hz. Two ways to send a sweep:
 //   --slices 0     whole, one ladar_scan_t of ~2.7 MB on LADAR_SCAN at the sweep's end (LCM
 //                  sends it as 44 fragments; the tracker receives and decodes it all at once);
-//   --slices auto  as vtrack-ladar-driver sends a 64-beam sweep: azimuth slices of one datagram
-//                  each on LADAR_SLICE (45 for these scans), each published when its own last
-//                  return is measured (the scan's start plus the slice's largest dt_us), so the
-//                  slices of a sweep spread over its 100 ms and the last one closes it.
+//   --slices auto  in the azimuth slices vtrack-ladar-driver cuts a 64-beam sweep into (one
+//                  datagram each on LADAR_SLICE, 46-47 for these scans), each published when
+//                  its own last return is measured (the scan's start plus the slice's largest
+//                  dt_us), in that order, as a sensor's packets come: the slices spread over the
+//                  sweep's 100 ms and the last one closes it. (The driver itself sends a sweep's
+//                  slices in one burst after the sweep, kSliceGapUs apart.)
 // The latency runs from the publication of the last return (the whole scan, or the last slice).
 // The poses through each scan's last return time are published before the scan (as on a vehicle,
 // where the pose source runs ahead of the sweep), so the latency is decoding + tracking +
@@ -65,6 +67,11 @@ struct Receiver {
   void OnStatus(const lcm::ReceiveBuffer*, const std::string&) { status_seen = true; }
 };
 
+// [us] When a slice's last return is measured, after the sweep's start (0 for an empty slice).
+std::int32_t LastDt(const vtrack::ladar_slice_t& s) {
+  return s.dt_us.empty() ? 0 : *std::max_element(s.dt_us.begin(), s.dt_us.end());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -118,8 +125,15 @@ int main(int argc, char** argv) {
     for (int i = 1; i <= n; ++i) frames.push_back(seq->Scan(i));
     for (vtrack::ladar_scan_t& f : frames) {
       const int count = vtrack::lcm_util::SlicesFor(*slices_option, f);
-      frame_slices.push_back(count == 0 ? std::vector<vtrack::ladar_slice_t>{}
-                                        : vtrack::lcm_util::SliceSweep(f, count));
+      std::vector<vtrack::ladar_slice_t> slices;
+      if (count > 0) slices = vtrack::lcm_util::SliceSweep(f, count);
+      // In the order their last returns are measured: the slicer follows the order of the
+      // returns in the file, which for KITTI (laser by laser, each in increasing azimuth) is not
+      // the order of the nominal per-return times (clockwise from behind, kitti_scan.h).
+      std::stable_sort(slices.begin(), slices.end(), [](const vtrack::ladar_slice_t& a, const vtrack::ladar_slice_t& b) {
+        return LastDt(a) < LastDt(b);
+      });
+      frame_slices.push_back(std::move(slices));
     }
   } catch (const std::exception& e) {
     std::cerr << "e2e_latency: KITTI data: " << e.what() << "\n";
@@ -182,8 +196,7 @@ int main(int argc, char** argv) {
       // Each slice when its last return is measured, from the scan's start (this tick); TRACKS
       // of the scan before are taken in the gaps.
       for (vtrack::ladar_slice_t& slice : slices) {
-        const std::int32_t last_dt = slice.dt_us.empty() ? 0 : *std::max_element(slice.dt_us.begin(), slice.dt_us.end());
-        handle_until(tick + std::chrono::microseconds(last_dt));
+        handle_until(tick + std::chrono::microseconds(LastDt(slice)));
         slice.utime = scan.utime;
         slice.seq = k;
         published[scan.utime] = Clock::now();

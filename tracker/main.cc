@@ -180,8 +180,9 @@ int RunOffline(const TrackerParams& params, const NodeOptions& options, const st
 // The memory a sweep frees stays with the process for the next sweep. By default glibc maps
 // each block of 128 KB or more afresh (a sweep's arrays are 0.5 MB each) and gives the top of
 // the heap back once it passes twice that, so every sweep's first touch of its arrays faults in
-// ~700 pages; on a virtual machine that took 6-10 ms of the latency for a sweep put back
-// together from its slices, against 0.25 ms with the pages kept (docs/results.md, "Speed").
+// ~700 pages. On a virtual machine a sweep put back together from its slices was ready 3-4 ms
+// after its last slice arrived, against under 1 ms with the pages kept (docs/results.md,
+// "Speed": the latency outside the tracker's own processing).
 // The price: the resident size stays at its peak instead of falling back after it.
 void KeepFreedMemory() {
   mallopt(M_MMAP_THRESHOLD, 32 << 20);  // [bytes] glibc's largest; blocks below come from the heap

@@ -8,8 +8,6 @@
 // time only. See tracker/README.md.
 #include <boost/program_options.hpp>
 
-#include <malloc.h>
-
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -177,22 +175,13 @@ int RunOffline(const TrackerParams& params, const NodeOptions& options, const st
   return 0;
 }
 
-// The memory a sweep frees stays with the process for the next sweep. By default glibc maps
-// each block of 128 KB or more afresh (a sweep's arrays are 0.5 MB each) and gives the top of
-// the heap back once it passes twice that, so every sweep's first touch of its arrays faults in
-// ~700 pages. On a virtual machine a sweep put back together from its slices was ready 3-4 ms
-// after its last slice arrived, against under 1 ms with the pages kept (docs/results.md,
-// "Speed": the latency outside the tracker's own processing).
-// The price: the resident size stays at its peak instead of falling back after it.
-void KeepFreedMemory() {
-  mallopt(M_MMAP_THRESHOLD, 32 << 20);  // [bytes] glibc's largest; blocks below come from the heap
-  mallopt(M_TRIM_THRESHOLD, 256 << 20);  // [bytes] free memory kept at the top of the heap
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  KeepFreedMemory();
+  // A sweep's memory kept for the next sweep (lcmtypes/util/process.h).
+  if (!vtrack::lcm_util::KeepFreedMemory()) {
+    std::fprintf(stderr, "vtrack-tracker: glibc refused to keep freed memory (mallopt); running with its defaults\n");
+  }
   std::string config, mode, input_mode, input, output, url;
   std::int64_t first_track_id = 0;
   NodeOptions options;

@@ -1,5 +1,6 @@
 #include "lcmtypes/util/process.h"
 
+#include <malloc.h>
 #include <sys/select.h>
 
 #include <atomic>
@@ -88,6 +89,12 @@ void RateLimitedLog::Warn(const std::string& key, const std::string& message) {
   e.printed = true;
   e.last = now;
   e.suppressed = 0;
+}
+
+bool KeepFreedMemory() {
+  const bool threshold = mallopt(M_MMAP_THRESHOLD, 32 << 20) == 1;  // [bytes] glibc's largest on 64-bit
+  const bool trim = mallopt(M_TRIM_THRESHOLD, 256 << 20) == 1;      // [bytes]
+  return threshold && trim;
 }
 
 }  // namespace vtrack::lcm_util

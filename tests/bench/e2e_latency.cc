@@ -67,6 +67,13 @@ struct Receiver {
   void OnStatus(const lcm::ReceiveBuffer*, const std::string&) { status_seen = true; }
 };
 
+// Mean slices per scan with one decimal ("46.9").
+std::string FormatSlicesPerScan(long slices, long scans) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f", static_cast<double>(slices) / static_cast<double>(scans));
+  return buf;
+}
+
 // [us] When a slice's last return is measured, after the sweep's start (0 for an empty slice).
 std::int32_t LastDt(const vtrack::ladar_slice_t& s) {
   return s.dt_us.empty() ? 0 : *std::max_element(s.dt_us.begin(), s.dt_us.end());
@@ -88,7 +95,8 @@ int main(int argc, char** argv) {
       "warmup", po::value(&warmup)->default_value(warmup), "first scans not counted")(
       "rate-hz", po::value(&rate_hz)->default_value(rate_hz), "scan rate [Hz]")(
       "slices", po::value(&slices_text)->default_value(slices_text),
-      "how each sweep is sent: 0 = whole on LADAR_SCAN; auto or N = N azimuth slices on "
+      "how each sweep is sent: 0 = whole, one message on LADAR_SCAN; auto = in the fewest azimuth "
+      "slices that each fit one datagram (46-47 for these scans), N = in N slices (1-4096), on "
       "LADAR_SLICE, each when its last return is measured")(
       "lcm-url", po::value(&url)->default_value("udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608"),
       "LCM URL (udpm)")("tracker-log", po::value(&log)->default_value("/tmp/e2e_latency_tracker.log"),
@@ -133,10 +141,16 @@ int main(int argc, char** argv) {
       std::stable_sort(slices.begin(), slices.end(), [](const vtrack::ladar_slice_t& a, const vtrack::ladar_slice_t& b) {
         return LastDt(a) < LastDt(b);
       });
+      if (!slices.empty()) {  // only the header is sent whole from now on
+        for (auto* v : {&f.x, &f.y, &f.z, &f.intensity}) std::vector<float>().swap(*v);
+        std::vector<std::int32_t>().swap(f.dt_us);
+        std::vector<std::int16_t>().swap(f.ring);
+        f.npoints = 0;
+      }
       frame_slices.push_back(std::move(slices));
     }
   } catch (const std::exception& e) {
-    std::cerr << "e2e_latency: KITTI data: " << e.what() << "\n";
+    std::cerr << "e2e_latency: KITTI data or its slices: " << e.what() << "\n";
     return 1;
   }
 
@@ -148,11 +162,13 @@ int main(int argc, char** argv) {
   Receiver rx;
   lcm.subscribe("TRACKS", &Receiver::OnTracks, &rx);
   lcm.subscribe("TRACKER_STATUS", &Receiver::OnStatus, &rx);
+  // Handles messages until deadline: waits in whole milliseconds (LCM's unit) while one or more
+  // are left, then polls, so that a slice does not go out before its time.
   auto handle_until = [&](Clock::time_point deadline) {
     for (;;) {
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+      const auto left = std::chrono::duration_cast<std::chrono::microseconds>(deadline - Clock::now()).count();
       if (left <= 0) return;
-      lcm.handleTimeout(static_cast<int>(std::max<long>(1, left)));
+      lcm.handleTimeout(static_cast<int>(left / 1000));
     }
   };
 
@@ -232,15 +248,15 @@ int main(int argc, char** argv) {
   }
   const double med = vtrack::bench::Percentile(ms, 50), p99 = vtrack::bench::Percentile(ms, 99),
                mx = vtrack::bench::Percentile(ms, 100);
-  // The tracker's own latency_us: from the sweep's arrival (the whole scan, or its last slice,
-  // received and decoded) to publishing TRACKS; the rest is the bus (fragmentation, loopback,
-  // reassembly) and decoding.
+  // The tracker's own latency_us: from the sweep being ready (the whole scan received and
+  // decoded, or put together from its slices) to publishing TRACKS; the rest is the bus
+  // (fragmentation, loopback, reassembly), the decoding and the putting together.
   const double proc_med = vtrack::bench::Percentile(proc, 50), proc_p99 = vtrack::bench::Percentile(proc, 99);
   const std::string sent =
       sliced_scans == 0 ? std::string("whole scans on LADAR_SCAN")
-                        : std::to_string(slices_sent / sliced_scans) + " slices a scan on LADAR_SLICE";
+                        : FormatSlicesPerScan(slices_sent, sliced_scans) + " slices a scan on LADAR_SLICE";
   std::printf("e2e latency over LCM (%zu scans at %.0f Hz, %s, %zu answered, %d lost): median %.2f ms, p99 %.2f ms, max %.2f ms; "
-              "in the tracker (last message received to publish): median %.2f ms, p99 %.2f ms\n",
+              "in the tracker (sweep ready to publish): median %.2f ms, p99 %.2f ms\n",
               counted.size(), rate_hz, sent.c_str(), ms.size(), lost, med, p99, mx, proc_med, proc_p99);
   if (!json.empty()) {
     std::ofstream os(json);
@@ -248,7 +264,7 @@ int main(int argc, char** argv) {
        << ", \"e2e_latency_ms_max\": " << mx << ", \"e2e_tracker_ms_median\": " << proc_med
        << ", \"e2e_tracker_ms_p99\": " << proc_p99 << ", \"e2e_scans\": " << counted.size()
        << ", \"e2e_lost\": " << lost << ", \"e2e_rate_hz\": " << rate_hz
-       << ", \"e2e_slices_per_scan\": " << (sliced_scans == 0 ? 0 : slices_sent / sliced_scans)
+       << ", \"e2e_slices_per_scan\": " << (sliced_scans == 0 ? 0.0 : static_cast<double>(slices_sent) / sliced_scans)
        << ", \"tracker_exit_status\": " << status << "}\n";
   }
   return 0;

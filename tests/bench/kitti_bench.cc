@@ -1,5 +1,6 @@
 // Reading and converting one KITTI frame: the .bin read, the scan message (per-return time and
-// ring), the ground truth with its point counts, and the LCM encoding of the scan. Uses frame 0 of
+// ring), the ground truth with its point counts, and the LCM encoding of the scan; and putting
+// the frame's sweep back together from its slices (BM_AssembleSweep). Uses frame 0 of
 // ../shared/data/kitti_tracking_0000 (unpacked into <build>/kitti_cache); without it, a synthetic
 // sweep of the same size (64 lasers x 1900 returns) laid out like a KITTI file.
 #include <benchmark/benchmark.h>

@@ -5,7 +5,8 @@
 // and the ego jump back, so the tracker also deletes and creates tracks in bulk.
 // Reports the process's resident set (VmRSS; the simulator's part is fixed: a scene and one scan
 // buffer) and malloc's bytes in use at the first minute (start: the track count has settled), at
-// the end and the peak, and rss_growth_pct = (end - start) / start.
+// the end and the peak, and rss_growth_pct = (end - start) / start. Memory is kept as
+// vtrack-tracker keeps it (KeepFreedMemory, lcmtypes/util/process.h).
 //
 //   build/bench/tracker_soak [--minutes 10] [--json F]
 #include <malloc.h>
@@ -17,6 +18,7 @@
 #include <iostream>
 #include <string>
 
+#include "lcmtypes/util/process.h"
 #include "tests/bench/bench_data.h"
 #include "tests/bench/bench_options.h"
 
@@ -46,6 +48,8 @@ int main(int argc, char** argv) {
       "minutes", po::value(&minutes)->default_value(minutes), "simulated length [min]")(
       "json", po::value(&json), "write the figures here");
   if (const auto status = vtrack::bench::ParseOptions("tracker_soak", desc, argc, argv)) return *status;
+  // The memory settings of vtrack-tracker, so that its resident size is what is measured.
+  if (!vtrack::lcm_util::KeepFreedMemory()) std::fprintf(stderr, "tracker_soak: glibc refused to keep freed memory\n");
   if (!(minutes >= 2.0 && minutes <= 120.0)) {
     std::cerr << "tracker_soak: --minutes " << minutes << " must be in [2, 120]\n";
     return 2;

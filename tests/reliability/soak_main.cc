@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "lcmtypes/util/decode.h"
+#include "lcmtypes/util/process.h"
 #include "sensor_driver/driver/sim_cli.h"
 #include "tests/support/encode.h"
 #include "tracker/config.h"
@@ -237,6 +238,8 @@ int Run(const po::variables_map& vm) {
 }  // namespace vtrack
 
 int main(int argc, char** argv) {
+  // The memory settings of vtrack-tracker, so that its resident size is what is measured.
+  if (!vtrack::lcm_util::KeepFreedMemory()) std::fprintf(stderr, "vtrack-soak: glibc refused to keep freed memory\n");
   po::options_description desc("Options");
   desc.add_options()("help,h", "print this help and exit");
   vtrack::sim::AddScenarioOptions(&desc, false);

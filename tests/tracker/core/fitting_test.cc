@@ -315,10 +315,11 @@ TEST(Fitting, ShortFaceWithJustEnoughReturnsStillMakesACorner) {
     SegmentFitter fitter(params);
     return fitter.Fit(req);
   };
-  for (const int long_face : {30, 45, 60}) {
-    // The fewest returns of the short face that the corner's rule takes.
-    int need = params.min_edge_inliers;
-    while (need < static_cast<int>(std::ceil(params.min_second_edge_fraction * (long_face + need)))) ++need;
+  // The fewest returns of the short face that the corner's rule takes, with the shipped
+  // min_edge_inliers (4) and min_second_edge_fraction (0.1): 4 of 34, 5 of 50, 7 of 67.
+  ASSERT_EQ(params.min_edge_inliers, 4);
+  ASSERT_EQ(params.min_second_edge_fraction, 0.1);
+  for (const auto& [long_face, need] : {std::pair{30, 4}, std::pair{45, 5}, std::pair{60, 7}}) {
     const FitResult corner = fit_l(long_face, need);
     ASSERT_EQ(corner.kind, FitKind::kCorner) << long_face << " + " << need << ": " << ToString(corner.failure);
     EXPECT_LT(corner.corner.norm(), 0.05);

@@ -13,10 +13,11 @@
 #include <cstdint>
 #include <memory>
 
-#if defined(__SANITIZE_ADDRESS__)
+// AddressSanitizer and ThreadSanitizer bring their own allocator, which mallopt does not steer.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 #define VTRACK_SANITIZED_ALLOCATOR 1
 #elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
 #define VTRACK_SANITIZED_ALLOCATOR 1
 #endif
 #endif

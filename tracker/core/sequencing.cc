@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <utility>
 
 namespace vtrack {
@@ -231,8 +232,10 @@ std::string ScanSequencer::CheckScan(const LadarScan& scan, const char** reason)
   }
   if (!scan.body_from_sensor.matrix().allFinite()) return "mounting pose is not finite";
   if (scan.body_from_sensor.translation().norm() > kMaxMountingOffset) {
-    return "mounting position " + std::to_string(scan.body_from_sensor.translation().norm()) +
-           " m from the body origin (more than " + std::to_string(kMaxMountingOffset) + ")";
+    std::ostringstream os;
+    os << "mounting position " << scan.body_from_sensor.translation().norm()
+       << " m from the body origin (at most " << kMaxMountingOffset << " m)";
+    return os.str();
   }
   if (!IsRotation(scan.body_from_sensor.linear())) return "mounting orientation is not a rotation";
   if (n == 0) {

@@ -19,6 +19,7 @@
 //
 //   scripts/vtrack-netns build/bench/e2e_latency --bin-dir build/bin [--scans 150] [--slices auto] [--json F]
 #include <lcm/lcm-cpp.hpp>
+#include <sys/select.h>
 
 #include <boost/program_options.hpp>
 
@@ -162,13 +163,21 @@ int main(int argc, char** argv) {
   Receiver rx;
   lcm.subscribe("TRACKS", &Receiver::OnTracks, &rx);
   lcm.subscribe("TRACKER_STATUS", &Receiver::OnStatus, &rx);
-  // Handles messages until deadline: waits in whole milliseconds (LCM's unit) while one or more
-  // are left, then polls, so that a slice does not go out before its time.
+  // Handles messages until deadline, waiting on LCM's socket with select() and its microsecond
+  // timeout: handleTimeout counts whole milliseconds, so the last millisecond before each slice
+  // would be a busy poll, and with ~47 slices a sweep that poll held most of a core that the
+  // tracker shares on a 2-core machine. select() may wake late by the kernel's timer slack
+  // (~50 us), never early, so no slice goes out before its time.
+  const int lcm_fd = lcm.getFileno();
   auto handle_until = [&](Clock::time_point deadline) {
     for (;;) {
       const auto left = std::chrono::duration_cast<std::chrono::microseconds>(deadline - Clock::now()).count();
       if (left <= 0) return;
-      lcm.handleTimeout(static_cast<int>(left / 1000));
+      fd_set readable;
+      FD_ZERO(&readable);
+      FD_SET(lcm_fd, &readable);
+      timeval timeout{static_cast<time_t>(left / 1'000'000), static_cast<suseconds_t>(left % 1'000'000)};
+      if (select(lcm_fd + 1, &readable, nullptr, nullptr, &timeout) > 0) lcm.handle();
     }
   };
 

@@ -381,6 +381,31 @@ TEST(AssociatorTest, SideOfALongMoverSeenEdgeOnJoinsIt) {
   EXPECT_EQ(res.new_objects.size(), 4u);
 }
 
+// A wall of 200 returns, 0.2 m apart along y = 0 from x = 0, and one track whose gate spans
+// 11.9 m of it: with exactly the share a candidate needs inside the gate (min_inside_fraction
+// 0.3: 60 of 200) the wall is a candidate of the track, with one return fewer it is not (the
+// early stop of the cost's loop and its count of the returns needed, at their limit).
+TEST(AssociatorTest, ALongWallIsACandidateOfAGateHoldingExactlyTheShareItNeeds) {
+  const Eigen::Vector2d sensor(6.0, -20.0);
+  WorldPoints pts;
+  for (int i = 0; i < 200; ++i) pts.push_back(0.2 * i, 0.0, 1.0f, i, 0);
+  const Segments segs = SegmentsOf(pts, {{0, 200}});
+  AssociationParams params;
+  params.miss_cost = 1e3;  // a candidate is assigned, whatever its cost
+  const auto assigned = [&](double centre_x) {
+    PredictedObject t = Pred(centre_x, 0.0, 0.0, /*established=*/false);
+    t.position_std = 0.0;               // gate margin: gate_margin alone, 0.8 m
+    t.box.length = 2.0 * (5.95 - 0.8);  // the gate reaches 5.95 m either side of the centre
+    Associator assoc(params);
+    AssociationResult res;
+    assoc.Run({t}, pts, segs, sensor, &res);
+    return res.track_points.at(0).size();
+  };
+  EXPECT_EQ(assigned(5.9), 200u);  // x in [-0.05, 11.85]: returns 0..59, 60 of them
+  EXPECT_EQ(assigned(5.8), 0u);    // x in [-0.15, 11.75]: returns 0..58, 59
+  EXPECT_EQ(assigned(40.0), 0u);   // beyond the wall's end: 1 return
+}
+
 TEST(AssociatorTest, AnyNumberOfThreadsGivesTheSameAssociation) {
   // A car park of 400 cars in 25 rows 4 m apart, either side of the sensor (neighbours' gates
   // overlap, so tracks compete for parts), tracked by 375 tracks predicted up to 0.6 m off

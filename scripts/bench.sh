@@ -150,6 +150,8 @@ jq -n \
        | {n: (.name | split("/")[1] | tonumber), ms: .median_ms}];
   bm($tb; "BM_TrackerScan_Kitti/") as $k | bm($tb; "BM_TrackerScan_Stress/") as $s |
   bm($tb; "BM_TrackerScan_Kitti_2Threads/") as $k2 |
+  bm($tb; "BM_TrackerScan_Kitti_2Threads_10Hz/") as $k10 |
+  bm($tb; "BM_TrackerScan_Kitti_2Threads_10Hz_Unpinned/") as $k10u |
   bm($pb; "BM_Pipeline_PclVoxelEuclidean") as $ppcl | bm($pb; "BM_Pipeline_VtrackTracker") as $pvt |
   bm($tb; "BM_TrackerScan_Fig4") as $f | bm($tb; "BM_CopyFloor_Kitti") as $c |
   scaling("BM_PointsScaling/") as $pts | scaling("BM_ObjectsScaling/") as $objs |
@@ -161,6 +163,9 @@ jq -n \
     kitti_tracks_per_scan: $k.tracks_per_scan,
     kitti_2threads_cpu_ms_median: $k2.median_ms, kitti_2threads_wall_ms_median: $k2.wall_median_ms,
     kitti_2threads_wall_ms_p99: $k2.wall_p99_ms,
+    kitti_2threads_10hz_wall_ms_median: $k10.wall_median_ms, kitti_2threads_10hz_wall_ms_p99: $k10.wall_p99_ms,
+    kitti_2threads_10hz_unpinned_wall_ms_median: $k10u.wall_median_ms,
+    kitti_2threads_10hz_unpinned_wall_ms_p99: $k10u.wall_p99_ms,
     kitti_stage_ms: (if $k == null then null else
       {preprocess: $k.pre_ms, segmentation: $k.seg_ms, association: $k.assoc_ms, updates_and_rest: $k.rest_ms} end),
     stress_ms_per_scan_median: $s.median_ms, stress_ms_per_scan_p99: $s.p99_ms,
@@ -209,6 +214,8 @@ jq -r '
   ["KITTI wall ms/scan median (shared machine)", f(.kitti_wall_ms_per_scan_median; 2), "", ""],
   ["KITTI 2 threads: CPU (both) median / wall median / wall p99",
     "\(f(.kitti_2threads_cpu_ms_median; 2)) / \(f(.kitti_2threads_wall_ms_median; 2)) / \(f(.kitti_2threads_wall_ms_p99; 2))", "", ""],
+  ["KITTI 2 threads, scans 100 ms apart: wall median / p99, pinned (shipped) | unpinned",
+    "\(f(.kitti_2threads_10hz_wall_ms_median; 2)) / \(f(.kitti_2threads_10hz_wall_ms_p99; 2)) | \(f(.kitti_2threads_10hz_unpinned_wall_ms_median; 2)) / \(f(.kitti_2threads_10hz_unpinned_wall_ms_p99; 2))", "", ""],
   ["KITTI returns / tracks per scan", "\(f(.kitti_points_per_scan; 0)) / \(f(.kitti_tracks_per_scan; 0))", "", ""],
   ["KITTI stages ms: preprocess / segment / associate / updates+rest",
     (if .kitti_stage_ms == null then "n/a" else "\(f(.kitti_stage_ms.preprocess; 2)) / \(f(.kitti_stage_ms.segmentation; 2)) / \(f(.kitti_stage_ms.association; 2)) / \(f(.kitti_stage_ms.updates_and_rest; 2))" end), "", ""],

@@ -178,6 +178,8 @@ template <class T>
 std::string ValidText([[maybe_unused]] T* value, const param::Info& info) {
   if constexpr (std::is_enum_v<T>) {
     return Choices<T>();
+  } else if constexpr (std::is_same_v<T, bool>) {
+    return "true or false";
   } else if constexpr (std::is_arithmetic_v<T>) {
     return info.range.ToString();
   } else {

@@ -8,7 +8,10 @@
 //  - BM_TrackerScan_Stress: the simulator's `stress` scenario (64 layers, ~300 vehicles);
 //  - BM_TrackerScan_Fig4: the single-plane paper_fig4_turn scenario;
 //  - BM_TrackerScan_Kitti_2Threads: KITTI with compute.threads = 2 (the shipped configuration):
-//    wall time, the latency a user sees, beside the CPU time of both threads.
+//    wall time, the latency a user sees, beside the CPU time of both threads; scans back to back;
+//  - BM_TrackerScan_Kitti_2Threads_10Hz and ..._10Hz_Unpinned: the same with each scan started
+//    100 ms after the one before, as a live tracker gets them (it sleeps in between), with the
+//    pool's threads pinned to CPUs of their own (compute.pin_threads, shipped) and not.
 // Counters per benchmark: median_ms / p99_ms / wall_median_ms over the timed scans and, for the
 // 3-D sequences, the stage breakdown (median ms): pre_ms (compensation + ground), seg_ms,
 // assoc_ms (prediction + association) measured by running those stages alone on the same input
@@ -29,12 +32,14 @@
 
 #include <time.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <map>
 #include <memory>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "tests/bench/bench_data.h"
@@ -102,8 +107,9 @@ TrackerParams Threads(int n) {
 
 // Times Tracker::AddScan of each scan after a warm-up of `warmup` scans; one iteration per scan
 // (the tracker is rebuilt and warmed up, untimed, when the sequence runs out).
+// period_ms > 0: each timed scan starts that long after the one before (the wait untimed).
 void RunSequence(benchmark::State& state, const Sequence& seq, int warmup, bool breakdown,
-                 const TrackerParams& params = Threads(1)) {
+                 const TrackerParams& params = Threads(1), int period_ms = 0) {
   if (!seq.error.empty()) {
     state.SkipWithError(seq.error.c_str());
     return;
@@ -120,6 +126,7 @@ void RunSequence(benchmark::State& state, const Sequence& seq, int warmup, bool 
   std::vector<ScanOutput> out;
   std::vector<double> cpu_ms, wall_ms, pre_ms, seg_ms, assoc_ms, rest_ms;
   double points = 0, tracks = 0;
+  auto next_start = std::chrono::steady_clock::now();
   for (auto _ : state) {
     if (i >= seq.scans.size()) {
       tracker = std::make_unique<Tracker>(params);
@@ -134,6 +141,10 @@ void RunSequence(benchmark::State& state, const Sequence& seq, int warmup, bool 
     LadarScan copy = seq.scans[i];
     points += static_cast<double>(copy.size());
     out.clear();
+    if (period_ms > 0) {
+      std::this_thread::sleep_until(next_start);
+      next_start = std::chrono::steady_clock::now() + std::chrono::milliseconds(period_ms);
+    }
     const double w0 = WallSeconds(), c0 = ProcessCpuSeconds();
     tracker->AddScan(std::move(copy), &out);  // processed here: its poses are in
     const double c1 = ProcessCpuSeconds(), w1 = WallSeconds();
@@ -180,11 +191,21 @@ void BM_TrackerScan_Fig4(benchmark::State& state) {
 void BM_TrackerScan_Kitti_2Threads(benchmark::State& state) {
   RunSequence(state, bench::Kitti(), 10, false, Threads(2));
 }
+void BM_TrackerScan_Kitti_2Threads_10Hz(benchmark::State& state) {
+  RunSequence(state, bench::Kitti(), 10, false, Threads(2), 100);
+}
+void BM_TrackerScan_Kitti_2Threads_10Hz_Unpinned(benchmark::State& state) {
+  TrackerParams params = Threads(2);
+  params.compute.pin_threads = false;
+  RunSequence(state, bench::Kitti(), 10, false, params, 100);
+}
 
 BENCHMARK(BM_TrackerScan_Kitti)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(90);
 BENCHMARK(BM_TrackerScan_Stress)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(90);
 BENCHMARK(BM_TrackerScan_Fig4)->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(150);
 BENCHMARK(BM_TrackerScan_Kitti_2Threads)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(90);
+BENCHMARK(BM_TrackerScan_Kitti_2Threads_10Hz)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(90);
+BENCHMARK(BM_TrackerScan_Kitti_2Threads_10Hz_Unpinned)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(90);
 
 // A plain copy of every point array of each scan, into buffers allocated once.
 void BM_CopyFloor_Kitti(benchmark::State& state) {

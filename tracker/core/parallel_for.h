@@ -1,6 +1,9 @@
 // Runs the calls of an index loop on a few threads at once.
 #pragma once
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <algorithm>
 #include <atomic>
 #include <condition_variable>
@@ -23,13 +26,24 @@ namespace vtrack {
 // Written with std::thread rather than OpenMP: the tracker's builds include clang's sanitizer
 // and fuzzing builds, where OpenMP needs another runtime (libomp) and is opaque to
 // ThreadSanitizer; two workers over an index range need no more than this.
+//
+// Pinning (pin = true): worker w runs on the w-th CPU of those the process may run on, and the
+// first thread that calls ParallelFor on the first of them, until the pool is destroyed on that
+// thread (its affinity is then restored). Without it, a tracker that sleeps between sweeps gets
+// little from its second thread: woken after ~90 ms asleep, the worker is placed on the CPU of
+// the thread that woke it (Linux's wake-affine placement), and the two run one after the other
+// until the scheduler moves one (docs/results.md, "Speed"). Nothing is pinned when the process
+// may run on fewer CPUs than there are threads; a refused pin is ignored, and so is another
+// thread calling later (pinned() says whether every thread, that caller included, is pinned).
 class WorkerPool {
  public:
   // threads: the calling thread (worker 0) and threads - 1 started here (workers 1 ...); 1 or
   // less: every loop runs on the calling thread.
   // If a thread cannot be started, those started are stopped and the error is thrown.
-  explicit WorkerPool(int threads) {
+  explicit WorkerPool(int threads, bool pin = false) {
     const int started = std::max(threads, 1) - 1;
+    if (pin && started > 0) cpus_ = AllowedCpus(started + 1);
+    pinned_ = !cpus_.empty();
     threads_.reserve(static_cast<std::size_t>(started));
     try {
       for (int w = 1; w <= started; ++w) threads_.emplace_back([this, w] { Serve(w); });
@@ -38,11 +52,19 @@ class WorkerPool {
       throw;
     }
   }
-  ~WorkerPool() { Stop(); }
+  ~WorkerPool() {
+    Stop();
+    if (caller_pinned_ && caller_ == std::this_thread::get_id()) {
+      pthread_setaffinity_np(pthread_self(), sizeof(caller_mask_), &caller_mask_);
+    }
+  }
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
 
   int threads() const { return static_cast<int>(threads_.size()) + 1; }
+  // Whether every thread of the pool, the last caller of a parallel loop included, is pinned
+  // to a CPU of its own.
+  bool pinned() const { return pinned_; }
 
   // Calls fn(i, worker) once for every i in [0, n); each worker takes the next index from a
   // shared counter as it finishes one, so which worker runs which index is not fixed. worker (in
@@ -63,6 +85,16 @@ class WorkerPool {
     if (threads_.empty() || n <= 1) {
       for (std::size_t i = 0; i < n; ++i) fn(i, 0);
       return;
+    }
+    if (!cpus_.empty() && caller_ != std::this_thread::get_id()) {
+      if (caller_ == std::thread::id() &&
+          pthread_getaffinity_np(pthread_self(), sizeof(caller_mask_), &caller_mask_) == 0 &&
+          PinTo(cpus_[0])) {
+        caller_pinned_ = true;
+      } else {
+        pinned_ = false;
+      }
+      caller_ = std::this_thread::get_id();
     }
     std::atomic<std::size_t> next{0};
     errors_.assign(threads_.size() + 1, nullptr);
@@ -118,7 +150,34 @@ class WorkerPool {
     for (std::thread& t : threads_) t.join();
   }
 
+  // The first n CPUs the process may run on, or none if there are fewer. The set is read once,
+  // when the first pool is made: a pool pins its caller, and a later pool made on that thread
+  // must not take the one CPU left to it for all there are.
+  static std::vector<int> AllowedCpus(int n) {
+    static const std::vector<int> allowed = [] {
+      std::vector<int> cpus;
+      cpu_set_t set;
+      CPU_ZERO(&set);
+      if (sched_getaffinity(0, sizeof(set), &set) != 0) return cpus;
+      for (int c = 0; c < CPU_SETSIZE; ++c) {
+        if (CPU_ISSET(c, &set)) cpus.push_back(c);
+      }
+      return cpus;
+    }();
+    if (static_cast<int>(allowed.size()) < n) return {};
+    return {allowed.begin(), allowed.begin() + n};
+  }
+
+  // Pins the calling thread to cpu; false if refused.
+  static bool PinTo(int cpu) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(cpu, &set);
+    return pthread_setaffinity_np(pthread_self(), sizeof(set), &set) == 0;
+  }
+
   void Serve(int worker) {
+    if (!cpus_.empty() && !PinTo(cpus_[static_cast<std::size_t>(worker)])) pinned_ = false;
     std::uint64_t seen = 0;
     for (;;) {
       const Loop* loop = nullptr;
@@ -139,6 +198,11 @@ class WorkerPool {
     }
   }
 
+  std::vector<int> cpus_;            // pinned: the CPU of each worker (0: the caller); else empty
+  std::atomic<bool> pinned_{false};
+  std::thread::id caller_;          // the last thread that called ParallelFor (pinning only)
+  bool caller_pinned_ = false;      // the first caller was pinned; its affinity was caller_mask_
+  cpu_set_t caller_mask_{};
   std::vector<std::thread> threads_;
   std::mutex mutex_;
   std::condition_variable wake_, done_;

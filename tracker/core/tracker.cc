@@ -61,7 +61,7 @@ Tracker::Tracker(const TrackerParams& params, bool debug)
     column_top_used_[three_d ? 1 : 0] =
         UsesFeature(params_.evidence, three_d, EvidenceFeature::kColumnTop);
   }
-  pool_ = std::make_unique<WorkerPool>(params_.compute.threads);
+  pool_ = std::make_unique<WorkerPool>(params_.compute.threads, params_.compute.pin_threads);
   preprocessor_.SetPool(pool_.get());
   associator_.SetPool(pool_.get());
   for (int k = 0; k < params_.compute.threads; ++k) {

@@ -10,12 +10,15 @@
 // (tests/integration/CMakeLists.txt): a new 64-beam case needs such a name.
 #include <gtest/gtest.h>
 
+#include <sched.h>
+
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <set>
@@ -81,7 +84,25 @@ struct LiveRun {
   std::int64_t start_utime = 0;
   // With a kill: [us, wall clock] when the tracker was killed and when its successor started.
   std::int64_t killed_utime = 0, restarted_utime = 0;
+  // The CPUs each thread of the live tracker may run on at the end of the lap, as the kernel
+  // lists them (/proc/PID/task/TID/status, Cpus_allowed_list).
+  std::vector<std::string> tracker_thread_cpus;
 };
+
+std::vector<std::string> ThreadCpus(pid_t pid) {
+  std::vector<std::string> out;
+  const std::string tasks = "/proc/" + std::to_string(pid) + "/task";
+  if (!std::filesystem::exists(tasks)) return out;
+  for (const auto& task : std::filesystem::directory_iterator(tasks)) {
+    std::ifstream in(task.path() / "status");
+    for (std::string line; std::getline(in, line);) {
+      if (line.rfind("Cpus_allowed_list:", 0) == 0) {
+        out.push_back(line.substr(line.find_first_not_of(" \t", 18)));
+      }
+    }
+  }
+  return out;
+}
 
 // What happens to the live tracker during the lap, at_s seconds into it: killed (SIGKILL) and
 // started again at once, both then taking their ids from their start time as in service; or
@@ -143,6 +164,7 @@ LiveRun RunLive(const std::string& scenario, double duration_s, double rate = 1.
     EXPECT_TRUE(rd && *rd == 0) << ReadFile(run.dir + "/driver.txt");
     EXPECT_TRUE(re && *re == 0) << ReadFile(run.dir + "/ego.txt");
     std::this_thread::sleep_for(1s);
+    run.tracker_thread_cpus = ThreadCpus(tracker->pid());
     EXPECT_EQ(tracker->Stop(), 0) << ReadFile(run.dir + (kill ? "/tracker_restarted.txt" : "/tracker.txt"));
     std::this_thread::sleep_for(300ms);
     logger.Stop();
@@ -287,6 +309,19 @@ TEST(TrackerLiveTest, UrbanIntersectionLiveWith64LayerScans) {
               static_cast<long long>(st.scans_received), static_cast<long long>(st.scans_processed),
               st.median_latency_ms);
   EXPECT_GE(st.scans_processed, 110);  // of 120: the large socket buffer keeps (nearly) all
+  // Live, the pool's two threads are pinned to two CPUs (compute.pin_threads), where the
+  // machine lets this process use two.
+  std::set<std::string> single_cpus;
+  for (const std::string& cpus : run.tracker_thread_cpus) {
+    std::printf("tracker thread: CPUs %s\n", cpus.c_str());
+    if (cpus.find_first_of(",-") == std::string::npos) single_cpus.insert(cpus);
+  }
+  cpu_set_t own;
+  CPU_ZERO(&own);
+  ASSERT_EQ(sched_getaffinity(0, sizeof(own), &own), 0);
+  if (CPU_COUNT(&own) >= 2) {
+    EXPECT_EQ(single_cpus.size(), 2u) << "threads pinned to a CPU of their own";
+  }
   EXPECT_GT(r.due, 500);
   for (const auto& m : r.misses) std::printf("  %s\n", m.c_str());
   for (const auto& [vehicle, ids] : r.ids) {

@@ -739,7 +739,7 @@ struct ComputeParams {
   template <class V>
   void Visit(V& v) {
     using namespace param;
-    v("pin_threads", &pin_threads, {"-", {}, "each thread of the pool on a CPU of its own (the thread that runs the tracker on the first the process may use): between sweeps 100 ms apart Linux otherwise places the woken worker beside the tracker's thread and the two run in turn (KITTI 0000 at 10 Hz: wall 17.4-18.6 ms unpinned, 12.0-13.5 pinned, docs/results.md); false: the scheduler places them"});
+    v("pin_threads", &pin_threads, {"-", {}, "live: each thread of the pool on a CPU of its own, the first ones the process may use (taskset chooses them), the thread that runs the tracker on the first: between sweeps 100 ms apart Linux otherwise places the woken worker beside the tracker's thread and the two run in turn (KITTI 0000 at 10 Hz, wall median 9.6-10.1 ms pinned, 12.6-13.5 unpinned: docs/results.md); false: the scheduler places them. vtrack-tracker --input never pins (scans back to back)"});
     v("threads", &threads, {"-", Closed(1, 64), "threads that share a scan's loops: the returns' placement and ground cells, the range profile beside the segmentation, the tracks' candidate pairs and their updates (each part independent of the others); 1: all on the calling thread. 2 on a 2-core computer: KITTI 0000 bench, see docs/results.md"});
   }
   bool Validate(std::string* error) const { return param::Validate(*this, error); }

@@ -19,13 +19,15 @@
 //
 //   scripts/vtrack-netns build/bench/e2e_latency --bin-dir build/bin [--scans 150] [--slices auto] [--json F]
 #include <lcm/lcm-cpp.hpp>
-#include <sys/select.h>
+#include <poll.h>
 
 #include <boost/program_options.hpp>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -163,28 +165,33 @@ int main(int argc, char** argv) {
   Receiver rx;
   lcm.subscribe("TRACKS", &Receiver::OnTracks, &rx);
   lcm.subscribe("TRACKER_STATUS", &Receiver::OnStatus, &rx);
-  // Handles messages until deadline, waiting on LCM's socket with select() and its microsecond
+  // Handles messages until deadline, waiting on LCM's socket with ppoll() and its nanosecond
   // timeout: handleTimeout counts whole milliseconds, so the last millisecond before each slice
   // would be a busy poll, and with ~47 slices a sweep that poll held most of a core that the
-  // tracker shares on a 2-core machine. select() may wake late by the kernel's timer slack
+  // tracker shares on a 2-core machine. ppoll() may wake late by the kernel's timer slack
   // (~50 us), never early, so no slice goes out before its time.
   const int lcm_fd = lcm.getFileno();
+  if (lcm_fd < 0) {
+    std::cerr << "e2e_latency: LCM gives no file descriptor to wait on\n";
+    return 1;
+  }
+  bool bus_failed = false;
   auto handle_until = [&](Clock::time_point deadline) {
-    for (;;) {
-      const auto left = std::chrono::duration_cast<std::chrono::microseconds>(deadline - Clock::now()).count();
+    while (!bus_failed) {
+      const auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - Clock::now()).count();
       if (left <= 0) return;
-      fd_set readable;
-      FD_ZERO(&readable);
-      FD_SET(lcm_fd, &readable);
-      timeval timeout{static_cast<time_t>(left / 1'000'000), static_cast<suseconds_t>(left % 1'000'000)};
-      if (select(lcm_fd + 1, &readable, nullptr, nullptr, &timeout) > 0) lcm.handle();
+      pollfd readable{lcm_fd, POLLIN, 0};
+      const timespec timeout{static_cast<time_t>(left / 1'000'000'000), static_cast<long>(left % 1'000'000'000)};
+      const int r = ppoll(&readable, 1, &timeout, nullptr);
+      if (r > 0 && lcm.handle() != 0) bus_failed = true;
+      if (r < 0 && errno != EINTR) bus_failed = true;
     }
   };
 
   vtrack::testing::Subprocess tracker({bin_dir + "/vtrack-tracker", "--lcm-url", url}, log);
   // Ready once it publishes its status (it subscribes before its first status).
   const auto ready_deadline = Clock::now() + std::chrono::seconds(20);
-  while (!rx.status_seen && Clock::now() < ready_deadline) handle_until(Clock::now() + std::chrono::milliseconds(100));
+  while (!rx.status_seen && !bus_failed && Clock::now() < ready_deadline) handle_until(Clock::now() + std::chrono::milliseconds(100));
   if (!rx.status_seen) {
     std::cerr << "e2e_latency: no TRACKER_STATUS from vtrack-tracker within 20 s (log: " << log << ")\n";
     return 1;
@@ -238,6 +245,10 @@ int main(int argc, char** argv) {
     if (k % 50 == 49) std::fprintf(stderr, "e2e_latency: %d/%d scans published\n", k + 1, scans);
   }
   handle_until(Clock::now() + std::chrono::seconds(2));
+  if (bus_failed) {
+    std::cerr << "e2e_latency: waiting on the LCM bus failed (" << std::strerror(errno) << ")\n";
+    return 1;
+  }
   const int status = tracker.Stop();
 
   std::vector<double> ms, proc;

@@ -27,14 +27,16 @@ namespace vtrack {
 // and fuzzing builds, where OpenMP needs another runtime (libomp) and is opaque to
 // ThreadSanitizer; two workers over an index range need no more than this.
 //
-// Pinning (pin = true): worker w runs on the w-th CPU of those the process may run on, and the
-// first thread that calls ParallelFor on the first of them, until the pool is destroyed on that
-// thread (its affinity is then restored). Without it, a tracker that sleeps between sweeps gets
-// little from its second thread: woken after ~90 ms asleep, the worker is placed on the CPU of
-// the thread that woke it (Linux's wake-affine placement), and the two run one after the other
-// until the scheduler moves one (docs/results.md, "Speed"). Nothing is pinned when the process
-// may run on fewer CPUs than there are threads; a refused pin is ignored, and so is another
-// thread calling later (pinned() says whether every thread, that caller included, is pinned).
+// Pinning (pin = true), where the process may use exactly as many CPUs as the pool has threads
+// (a machine of that size, or the CPUs chosen with taskset): worker w runs on the w-th of them,
+// and the first thread that calls ParallelFor on the first, until the last pinned pool it
+// called is destroyed on it (its affinity is then restored). Unpinned, a tracker that sleeps
+// between sweeps gets little from its second thread on a 2-CPU machine: the worker, woken after
+// ~90 ms asleep, is placed on the CPU of the thread that woke it (Linux's wake-affine
+// placement), and the two run one after the other until the scheduler moves one
+// (docs/results.md, "Speed"). With more CPUs than threads nothing is pinned: the scheduler then
+// finds an idle CPU, and pinning to fixed ones (CPU 0 takes most interrupts) could only hurt.
+// A refused pin is ignored, and so is another thread calling later.
 class WorkerPool {
  public:
   // threads: the calling thread (worker 0) and threads - 1 started here (workers 1 ...); 1 or
@@ -42,7 +44,7 @@ class WorkerPool {
   // If a thread cannot be started, those started are stopped and the error is thrown.
   explicit WorkerPool(int threads, bool pin = false) {
     const int started = std::max(threads, 1) - 1;
-    if (pin && started > 0) cpus_ = AllowedCpus(started + 1);
+    if (pin && started > 0) cpus_ = AllowedCpus(started + 1);  // empty: not pinned
     pinned_ = !cpus_.empty();
     threads_.reserve(static_cast<std::size_t>(started));
     try {
@@ -55,15 +57,18 @@ class WorkerPool {
   ~WorkerPool() {
     Stop();
     if (caller_pinned_ && caller_ == std::this_thread::get_id()) {
-      pthread_setaffinity_np(pthread_self(), sizeof(caller_mask_), &caller_mask_);
+      CallerPin& pin = CallerPinOfThisThread();
+      if (pin.pools > 0 && --pin.pools == 0) {
+        pthread_setaffinity_np(pthread_self(), sizeof(pin.mask), &pin.mask);
+      }
     }
   }
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
 
   int threads() const { return static_cast<int>(threads_.size()) + 1; }
-  // Whether every thread of the pool, the last caller of a parallel loop included, is pinned
-  // to a CPU of its own.
+  // Whether the pool's threads are pinned, each to a CPU of its own (its first caller too, from
+  // its first parallel loop on).
   bool pinned() const { return pinned_; }
 
   // Calls fn(i, worker) once for every i in [0, n); each worker takes the next index from a
@@ -86,16 +91,7 @@ class WorkerPool {
       for (std::size_t i = 0; i < n; ++i) fn(i, 0);
       return;
     }
-    if (!cpus_.empty() && caller_ != std::this_thread::get_id()) {
-      if (caller_ == std::thread::id() &&
-          pthread_getaffinity_np(pthread_self(), sizeof(caller_mask_), &caller_mask_) == 0 &&
-          PinTo(cpus_[0])) {
-        caller_pinned_ = true;
-      } else {
-        pinned_ = false;
-      }
-      caller_ = std::this_thread::get_id();
-    }
+    if (!cpus_.empty() && caller_ != std::this_thread::get_id()) PinCaller();
     std::atomic<std::size_t> next{0};
     errors_.assign(threads_.size() + 1, nullptr);
     Loop loop{n, &next, const_cast<void*>(static_cast<const void*>(&fn)),
@@ -150,9 +146,40 @@ class WorkerPool {
     for (std::thread& t : threads_) t.join();
   }
 
-  // The first n CPUs the process may run on, or none if there are fewer. The set is read once,
-  // when the first pool is made: a pool pins its caller, and a later pool made on that thread
-  // must not take the one CPU left to it for all there are.
+  // The affinity a thread had before the pools it called pinned it, and how many of those
+  // pools are alive (several trackers may be driven from one thread).
+  struct CallerPin {
+    int pools = 0;
+    cpu_set_t mask{};
+  };
+  static CallerPin& CallerPinOfThisThread() {
+    thread_local CallerPin pin;
+    return pin;
+  }
+
+  // Pins the calling thread to cpus_[0] if it is the first to call; another thread that calls
+  // later is left as it is.
+  void PinCaller() {
+    const bool first = caller_ == std::thread::id();
+    caller_ = std::this_thread::get_id();
+    if (!first) {
+      pinned_ = false;
+      return;
+    }
+    CallerPin& pin = CallerPinOfThisThread();
+    if (pin.pools == 0 &&
+        (pthread_getaffinity_np(pthread_self(), sizeof(pin.mask), &pin.mask) != 0 ||
+         !PinTo(cpus_[0]))) {
+      pinned_ = false;
+      return;
+    }
+    ++pin.pools;  // pinned to cpus_[0] already by another pool (the same set: AllowedCpus)
+    caller_pinned_ = true;
+  }
+
+  // The CPUs the process may run on if there are exactly n, else none. Read once, when the
+  // first pool is made, from the calling thread's affinity (the process's, before any pool
+  // pinned a thread): a later pool made on a pinned thread must see the same set.
   static std::vector<int> AllowedCpus(int n) {
     static const std::vector<int> allowed = [] {
       std::vector<int> cpus;
@@ -164,8 +191,8 @@ class WorkerPool {
       }
       return cpus;
     }();
-    if (static_cast<int>(allowed.size()) < n) return {};
-    return {allowed.begin(), allowed.begin() + n};
+    if (static_cast<int>(allowed.size()) != n) return {};
+    return allowed;
   }
 
   // Pins the calling thread to cpu; false if refused.
@@ -201,8 +228,7 @@ class WorkerPool {
   std::vector<int> cpus_;            // pinned: the CPU of each worker (0: the caller); else empty
   std::atomic<bool> pinned_{false};
   std::thread::id caller_;          // the last thread that called ParallelFor (pinning only)
-  bool caller_pinned_ = false;      // the first caller was pinned; its affinity was caller_mask_
-  cpu_set_t caller_mask_{};
+  bool caller_pinned_ = false;      // the first caller was pinned (its CallerPin counts this pool)
   std::vector<std::thread> threads_;
   std::mutex mutex_;
   std::condition_variable wake_, done_;

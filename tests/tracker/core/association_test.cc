@@ -403,7 +403,7 @@ TEST(AssociatorTest, ALongWallIsACandidateOfAGateHoldingExactlyTheShareItNeeds) 
   };
   EXPECT_EQ(assigned(5.9), 200u);  // x in [-0.05, 11.85]: returns 0..59, 60 of them
   EXPECT_EQ(assigned(5.8), 0u);    // x in [-0.15, 11.75]: returns 0..58, 59
-  EXPECT_EQ(assigned(40.0), 0u);   // beyond the wall's end: 1 return
+  EXPECT_EQ(assigned(45.7), 0u);   // x in [39.75, 51.65], past the wall's end: 1 return
 }
 
 TEST(AssociatorTest, AnyNumberOfThreadsGivesTheSameAssociation) {

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <memory>
 #include <mutex>
 #include <set>
 #include <stdexcept>
@@ -76,50 +77,72 @@ std::vector<int> AffinityOf(pthread_t thread) {
   return cpus;
 }
 
+// Whether this process may pin a thread at all (a container may refuse it).
+bool CanPin(int cpu) {
+  bool ok = false;
+  std::thread([&] {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(cpu, &set);
+    ok = pthread_setaffinity_np(pthread_self(), sizeof(set), &set) == 0;
+  }).join();
+  return ok;
+}
+
 TEST(WorkerPool, PinnedThreadsEachRunOnOneCpuOfTheirOwn) {
   const pthread_t self = pthread_self();
   const std::vector<int> allowed = AffinityOf(self);
-  if (allowed.size() < 2) GTEST_SKIP() << "the process may run on " << allowed.size() << " CPU";
-  // Each worker's affinity as the kernel reports it, from inside its calls (each call waits for
-  // the other worker to start one, so both take part).
+  const int n = static_cast<int>(allowed.size());
+  if (n < 2 || n > 16 || !CanPin(allowed[1])) {
+    GTEST_SKIP() << "the process may run on " << n << " CPUs, or may not pin a thread";
+  }
+  // Each worker's affinity as the kernel reports it, from inside its calls (each call waits
+  // until every worker has started one, so all take part).
   auto affinities = [](WorkerPool* pool) {
-    std::vector<std::vector<int>> seen(2);
+    const int threads = pool->threads();
+    std::vector<std::vector<int>> seen(static_cast<std::size_t>(threads));
     std::atomic<int> started{0};
     std::mutex m;
-    pool->ParallelFor(2, [&](std::size_t, int worker) {
+    pool->ParallelFor(static_cast<std::size_t>(threads), [&](std::size_t, int worker) {
       started.fetch_add(1);
       const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-      while (started.load() < 2 && std::chrono::steady_clock::now() < until) std::this_thread::yield();
+      while (started.load() < threads && std::chrono::steady_clock::now() < until) std::this_thread::yield();
       std::lock_guard<std::mutex> lock(m);
       seen[static_cast<std::size_t>(worker)] = AffinityOf(pthread_self());
     });
     return seen;
   };
   {
-    WorkerPool pool(2, /*pin=*/false);
-    const auto seen = affinities(&pool);
-    EXPECT_EQ(seen[0], allowed);
-    EXPECT_EQ(seen[1], allowed);
+    WorkerPool pool(n, /*pin=*/false);
+    for (const auto& cpus : affinities(&pool)) EXPECT_EQ(cpus, allowed);
     EXPECT_FALSE(pool.pinned());
   }
   {
-    WorkerPool pool(2, /*pin=*/true);
-    const auto seen = affinities(&pool);
-    EXPECT_EQ(seen[0], std::vector<int>{allowed[0]});  // the calling thread
-    EXPECT_EQ(seen[1], std::vector<int>{allowed[1]});
-    EXPECT_TRUE(pool.pinned());
+    // As many threads as CPUs: each on its own, the calling thread (worker 0) on the first.
+    auto pool = std::make_unique<WorkerPool>(n, /*pin=*/true);
+    const auto seen = affinities(pool.get());
+    for (int w = 0; w < n; ++w) {
+      EXPECT_EQ(seen[static_cast<std::size_t>(w)], std::vector<int>{allowed[static_cast<std::size_t>(w)]});
+    }
+    EXPECT_TRUE(pool->pinned());
     EXPECT_EQ(AffinityOf(self), std::vector<int>{allowed[0]});  // between loops too
-    // A second pool made meanwhile on the pinned thread pins as the first did.
-    WorkerPool second(2, /*pin=*/true);
-    const auto seen_second = affinities(&second);
-    EXPECT_EQ(seen_second[1], std::vector<int>{allowed[1]});
-    EXPECT_TRUE(second.pinned());
+    // A second pool on the pinned thread pins as the first did; the thread is set free when
+    // the last of them goes, here the second (pools destroyed in the order they were made).
+    auto second = std::make_unique<WorkerPool>(n, /*pin=*/true);
+    EXPECT_EQ(affinities(second.get()).back(), std::vector<int>{allowed.back()});
+    EXPECT_TRUE(second->pinned());
+    pool.reset();
+    EXPECT_EQ(AffinityOf(self), std::vector<int>{allowed[0]});
+    second.reset();
   }
-  EXPECT_EQ(AffinityOf(self), allowed);  // restored when the pool goes
-  // Nothing is pinned where the process may not run on a CPU for each thread.
-  WorkerPool many(static_cast<int>(allowed.size()) + 1, /*pin=*/true);
-  EXPECT_FALSE(many.pinned());
-  many.ParallelFor(4, [](std::size_t, int) {});
+  EXPECT_EQ(AffinityOf(self), allowed);  // restored when the last pinned pool goes
+  // Nothing is pinned with more threads than CPUs, or fewer (the scheduler finds idle CPUs).
+  for (const int threads : {n + 1, n - 1}) {
+    if (threads < 2) continue;
+    WorkerPool pool(threads, /*pin=*/true);
+    EXPECT_FALSE(pool.pinned()) << threads << " threads";
+    for (const auto& cpus : affinities(&pool)) EXPECT_EQ(cpus, allowed) << threads << " threads";
+  }
   EXPECT_EQ(AffinityOf(self), allowed);
 }
 

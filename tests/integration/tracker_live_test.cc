@@ -10,7 +10,6 @@
 // (tests/integration/CMakeLists.txt): a new 64-beam case needs such a name.
 #include <gtest/gtest.h>
 
-#include <pthread.h>
 #include <sched.h>
 
 #include <chrono>
@@ -31,6 +30,7 @@
 #include "lcmtypes/util/log_reader.h"
 #include "lcmtypes/util/process.h"
 #include "tests/integration/tracker_eval.h"
+#include "tests/support/affinity.h"
 #include "tests/support/subprocess.h"
 #include "tests/support/test_env.h"
 #include "vtrack/track_list_t.hpp"
@@ -183,20 +183,6 @@ LiveRun RunLive(const std::string& scenario, double duration_s, double rate = 1.
   return run;
 }
 
-// Whether a thread of this process may be pinned to one CPU of `cpus`.
-bool CanPinAThread(const cpu_set_t& cpus) {
-  int cpu = 0;
-  while (!CPU_ISSET(cpu, &cpus)) ++cpu;
-  bool ok = false;
-  std::thread([&] {
-    cpu_set_t one;
-    CPU_ZERO(&one);
-    CPU_SET(cpu, &one);
-    ok = pthread_setaffinity_np(pthread_self(), sizeof(one), &one) == 0;
-  }).join();
-  return ok;
-}
-
 tracker_status_t LastStatus(const std::string& path) {
   tracker_status_t last{};  // zeros if the log holds none
   lcm_util::LogReader r(path);
@@ -334,7 +320,7 @@ TEST(TrackerLiveTest, UrbanIntersectionLiveWith64LayerScans) {
   cpu_set_t own;
   CPU_ZERO(&own);
   ASSERT_EQ(sched_getaffinity(0, sizeof(own), &own), 0);
-  if (CPU_COUNT(&own) == 2 && CanPinAThread(own)) {
+  if (CPU_COUNT(&own) == 2 && CanPinAThread(AffinityOf(pthread_self()).front())) {
     EXPECT_EQ(single_cpus.size(), 2u) << "threads pinned to a CPU of their own";
   }
   EXPECT_GT(r.due, 500);

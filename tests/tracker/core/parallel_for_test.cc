@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <pthread.h>
-#include <sched.h>
 
 #include <algorithm>
 #include <atomic>
@@ -18,6 +17,8 @@
 #include <stdexcept>
 #include <thread>
 #include <vector>
+
+#include "tests/support/affinity.h"
 
 namespace vtrack {
 namespace {
@@ -65,35 +66,11 @@ TEST(WorkerPool, RunsOnMoreThanOneThreadWhenAsked) {
   EXPECT_EQ(threads_seen(2), 2u);
 }
 
-// The CPUs a thread may run on, as the kernel reports them.
-std::vector<int> AffinityOf(pthread_t thread) {
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  EXPECT_EQ(pthread_getaffinity_np(thread, sizeof(set), &set), 0);
-  std::vector<int> cpus;
-  for (int c = 0; c < CPU_SETSIZE; ++c) {
-    if (CPU_ISSET(c, &set)) cpus.push_back(c);
-  }
-  return cpus;
-}
-
-// Whether this process may pin a thread at all (a container may refuse it).
-bool CanPin(int cpu) {
-  bool ok = false;
-  std::thread([&] {
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    CPU_SET(cpu, &set);
-    ok = pthread_setaffinity_np(pthread_self(), sizeof(set), &set) == 0;
-  }).join();
-  return ok;
-}
-
 TEST(WorkerPool, PinnedThreadsEachRunOnOneCpuOfTheirOwn) {
   const pthread_t self = pthread_self();
-  const std::vector<int> allowed = AffinityOf(self);
+  const std::vector<int> allowed = testing::AffinityOf(self);
   const int n = static_cast<int>(allowed.size());
-  if (n < 2 || n > 16 || !CanPin(allowed[1])) {
+  if (n < 2 || n > 16 || !testing::CanPinAThread(allowed[1])) {
     GTEST_SKIP() << "the process may run on " << n << " CPUs, or may not pin a thread";
   }
   // Each worker's affinity as the kernel reports it, from inside its calls (each call waits
@@ -108,7 +85,7 @@ TEST(WorkerPool, PinnedThreadsEachRunOnOneCpuOfTheirOwn) {
       const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
       while (started.load() < threads && std::chrono::steady_clock::now() < until) std::this_thread::yield();
       std::lock_guard<std::mutex> lock(m);
-      seen[static_cast<std::size_t>(worker)] = AffinityOf(pthread_self());
+      seen[static_cast<std::size_t>(worker)] = testing::AffinityOf(pthread_self());
     });
     return seen;
   };
@@ -125,17 +102,17 @@ TEST(WorkerPool, PinnedThreadsEachRunOnOneCpuOfTheirOwn) {
       EXPECT_EQ(seen[static_cast<std::size_t>(w)], std::vector<int>{allowed[static_cast<std::size_t>(w)]});
     }
     EXPECT_TRUE(pool->pinned());
-    EXPECT_EQ(AffinityOf(self), std::vector<int>{allowed[0]});  // between loops too
+    EXPECT_EQ(testing::AffinityOf(self), std::vector<int>{allowed[0]});  // between loops too
     // A second pool on the pinned thread pins as the first did; the thread is set free when
     // the last of them goes, here the second (pools destroyed in the order they were made).
     auto second = std::make_unique<WorkerPool>(n, /*pin=*/true);
     EXPECT_EQ(affinities(second.get()).back(), std::vector<int>{allowed.back()});
     EXPECT_TRUE(second->pinned());
     pool.reset();
-    EXPECT_EQ(AffinityOf(self), std::vector<int>{allowed[0]});
+    EXPECT_EQ(testing::AffinityOf(self), std::vector<int>{allowed[0]});
     second.reset();
   }
-  EXPECT_EQ(AffinityOf(self), allowed);  // restored when the last pinned pool goes
+  EXPECT_EQ(testing::AffinityOf(self), allowed);  // restored when the last pinned pool goes
   // Nothing is pinned with more threads than CPUs, or fewer (the scheduler finds idle CPUs).
   for (const int threads : {n + 1, n - 1}) {
     if (threads < 2) continue;
@@ -143,7 +120,7 @@ TEST(WorkerPool, PinnedThreadsEachRunOnOneCpuOfTheirOwn) {
     EXPECT_FALSE(pool.pinned()) << threads << " threads";
     for (const auto& cpus : affinities(&pool)) EXPECT_EQ(cpus, allowed) << threads << " threads";
   }
-  EXPECT_EQ(AffinityOf(self), allowed);
+  EXPECT_EQ(testing::AffinityOf(self), allowed);
 }
 
 TEST(WorkerPool, AnExceptionOfOneCallReachesTheCallerAndThePoolGoesOn) {

@@ -176,6 +176,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   bool bus_failed = false;
+  std::string bus_error;
   auto handle_until = [&](Clock::time_point deadline) {
     while (!bus_failed) {
       const auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - Clock::now()).count();
@@ -183,8 +184,13 @@ int main(int argc, char** argv) {
       pollfd readable{lcm_fd, POLLIN, 0};
       const timespec timeout{static_cast<time_t>(left / 1'000'000'000), static_cast<long>(left % 1'000'000'000)};
       const int r = ppoll(&readable, 1, &timeout, nullptr);
-      if (r > 0 && lcm.handle() != 0) bus_failed = true;
-      if (r < 0 && errno != EINTR) bus_failed = true;
+      if (r < 0 && errno != EINTR) {
+        bus_error = std::string("ppoll: ") + std::strerror(errno);
+        bus_failed = true;
+      } else if (r > 0 && lcm.handle() != 0) {
+        bus_error = "lcm handle() failed";
+        bus_failed = true;
+      }
     }
   };
 
@@ -192,6 +198,10 @@ int main(int argc, char** argv) {
   // Ready once it publishes its status (it subscribes before its first status).
   const auto ready_deadline = Clock::now() + std::chrono::seconds(20);
   while (!rx.status_seen && !bus_failed && Clock::now() < ready_deadline) handle_until(Clock::now() + std::chrono::milliseconds(100));
+  if (bus_failed) {
+    std::cerr << "e2e_latency: waiting on the LCM bus failed: " << bus_error << "\n";
+    return 1;
+  }
   if (!rx.status_seen) {
     std::cerr << "e2e_latency: no TRACKER_STATUS from vtrack-tracker within 20 s (log: " << log << ")\n";
     return 1;
@@ -246,7 +256,7 @@ int main(int argc, char** argv) {
   }
   handle_until(Clock::now() + std::chrono::seconds(2));
   if (bus_failed) {
-    std::cerr << "e2e_latency: waiting on the LCM bus failed (" << std::strerror(errno) << ")\n";
+    std::cerr << "e2e_latency: waiting on the LCM bus failed: " << bus_error << "\n";
     return 1;
   }
   const int status = tracker.Stop();

@@ -46,6 +46,13 @@ class WorkerPool {
     const int started = std::max(threads, 1) - 1;
     if (pin && started > 0) cpus_ = AllowedCpus(started + 1);  // empty: not pinned
     pinned_ = !cpus_.empty();
+    // Threads start with their creator's affinity: on a thread a pinned pool holds to one CPU,
+    // an unpinned pool's workers get the CPUs that thread had before.
+    const CallerPin& creator = CallerPinOfThisThread();
+    if (cpus_.empty() && creator.pools > 0) {
+      free_mask_ = creator.mask;
+      free_workers_ = true;
+    }
     threads_.reserve(static_cast<std::size_t>(started));
     try {
       for (int w = 1; w <= started; ++w) threads_.emplace_back([this, w] { Serve(w); });
@@ -56,7 +63,7 @@ class WorkerPool {
   }
   ~WorkerPool() {
     Stop();
-    if (caller_pinned_ && caller_ == std::this_thread::get_id()) {
+    if (pinned_caller_ == std::this_thread::get_id()) {
       CallerPin& pin = CallerPinOfThisThread();
       if (pin.pools > 0 && --pin.pools == 0) {
         pthread_setaffinity_np(pthread_self(), sizeof(pin.mask), &pin.mask);
@@ -174,7 +181,7 @@ class WorkerPool {
       return;
     }
     ++pin.pools;  // pinned to cpus_[0] already by another pool (the same set: AllowedCpus)
-    caller_pinned_ = true;
+    pinned_caller_ = caller_;
   }
 
   // The CPUs the process may run on if there are exactly n, else none. Read once, when the
@@ -205,6 +212,7 @@ class WorkerPool {
 
   void Serve(int worker) {
     if (!cpus_.empty() && !PinTo(cpus_[static_cast<std::size_t>(worker)])) pinned_ = false;
+    if (free_workers_) pthread_setaffinity_np(pthread_self(), sizeof(free_mask_), &free_mask_);
     std::uint64_t seen = 0;
     for (;;) {
       const Loop* loop = nullptr;
@@ -228,7 +236,9 @@ class WorkerPool {
   std::vector<int> cpus_;            // pinned: the CPU of each worker (0: the caller); else empty
   std::atomic<bool> pinned_{false};
   std::thread::id caller_;          // the last thread that called ParallelFor (pinning only)
-  bool caller_pinned_ = false;      // the first caller was pinned (its CallerPin counts this pool)
+  std::thread::id pinned_caller_;   // the first caller, if pinned (its CallerPin counts this pool)
+  bool free_workers_ = false;       // unpinned pool made on a pinned thread: workers get free_mask_
+  cpu_set_t free_mask_{};
   std::vector<std::thread> threads_;
   std::mutex mutex_;
   std::condition_variable wake_, done_;

@@ -82,7 +82,7 @@ TEST(WorkerPool, PinnedThreadsEachRunOnOneCpuOfTheirOwn) {
     std::mutex m;
     pool->ParallelFor(static_cast<std::size_t>(threads), [&](std::size_t, int worker) {
       started.fetch_add(1);
-      const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+      const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
       while (started.load() < threads && std::chrono::steady_clock::now() < until) std::this_thread::yield();
       std::lock_guard<std::mutex> lock(m);
       seen[static_cast<std::size_t>(worker)] = testing::AffinityOf(pthread_self());
@@ -108,6 +108,12 @@ TEST(WorkerPool, PinnedThreadsEachRunOnOneCpuOfTheirOwn) {
     auto second = std::make_unique<WorkerPool>(n, /*pin=*/true);
     EXPECT_EQ(affinities(second.get()).back(), std::vector<int>{allowed.back()});
     EXPECT_TRUE(second->pinned());
+    {
+      // An unpinned pool made on the pinned thread: its workers get the CPUs the thread had.
+      WorkerPool unpinned(n, /*pin=*/false);
+      const auto seen_unpinned = affinities(&unpinned);
+      for (int w = 1; w < n; ++w) EXPECT_EQ(seen_unpinned[static_cast<std::size_t>(w)], allowed);
+    }
     pool.reset();
     EXPECT_EQ(testing::AffinityOf(self), std::vector<int>{allowed[0]});
     second.reset();

@@ -288,6 +288,11 @@ int main(int argc, char** argv) {
       std::cerr << "vtrack-tracker: --input-mode '" << input_mode << "' must be scans, boxes or fused\n";
       return 2;
     }
+    if (!input.empty()) {
+      // Offline the scans come back to back, where pinned threads gain nothing, and several
+      // runs may share the machine: they would all be pinned to its first CPUs.
+      params.compute.pin_threads = false;
+    }
     std::string error;
     if (!params.Validate(&error)) {
       std::cerr << "vtrack-tracker: invalid parameters: " << error << "\n";
@@ -299,9 +304,6 @@ int main(int argc, char** argv) {
     }
     lcm_util::InstallStopHandlers();
     if (!input.empty()) {
-      // Offline the scans come back to back, where pinned threads gain nothing, and several
-      // runs may share the machine: they would all be pinned to its first CPUs.
-      params.compute.pin_threads = false;
       return RunOffline(params, options, input, output, status_period, vm.count("quiet") > 0);
     }
     return RunLive(params, options, url, status_period);

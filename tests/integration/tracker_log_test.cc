@@ -537,6 +537,18 @@ TEST(TrackerCliTest, HelpAndBadOptions) {
                         "/tmp/vtrack-never.lcm"}), 1);
 }
 
+// --print-config prints the parameters in effect: offline (--input) the threads are not pinned,
+// whatever the configuration says; live they are as configured (pinned by default).
+TEST(TrackerCliTest, OfflineRunsDoNotPinTheirThreads) {
+  const std::string dir = ScratchDir("tracker_cli_pin");
+  const std::string offline = dir + "/offline.txt", live = dir + "/live.txt";
+  ASSERT_EQ(RunCommand({Bin("vtrack-tracker"), "--input", "/dev/null", "--output", dir + "/o.lcm",
+                        "--print-config"}, offline, std::chrono::seconds(30)), 0);
+  EXPECT_NE(ReadFile(offline).find("pin_threads: false"), std::string::npos) << ReadFile(offline);
+  ASSERT_EQ(RunCommand({Bin("vtrack-tracker"), "--print-config"}, live, std::chrono::seconds(30)), 0);
+  EXPECT_NE(ReadFile(live).find("pin_threads: true"), std::string::npos) << ReadFile(live);
+}
+
 // An argument that is not an option (a log given without --input) would be ignored and the
 // tracker would go live: refused, naming it. So is an empty channel name.
 TEST(TrackerCliTest, StrayArgumentsAndEmptyChannelsAreRefused) {

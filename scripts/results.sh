@@ -379,6 +379,8 @@ $bench_cmd
 \`\`\`
 
 $(bench_table "$bench_json")
+
+Studies of the threads, their pinning and the memory kept between sweeps, each with the commands that reproduce it: [docs/speed.md](speed.md).
 EOF
   else
     cat <<EOF
@@ -386,6 +388,7 @@ EOF
 ## Speed
 
 Not measured in this run: \`scripts/results.sh --bench\` adds the benchmarks (about 10 minutes).
+Studies of the threads, their pinning and the memory kept between sweeps: [docs/speed.md](speed.md).
 EOF
   fi
 } >"$out.tmp"

@@ -38,7 +38,7 @@ std::int64_t WallUtime();
 // threshold then rises to the largest block freed, and the heap's top is given back once twice
 // that is free, so a sweep's arrays (0.5 MB each) keep faulting in fresh pages; on a virtual
 // machine that made a sweep put together from its slices ready 3-4 ms after its last slice,
-// against under 1 ms with the pages kept (docs/results.md, "Speed"). The resident size stays at
+// against under 1 ms with the pages kept (docs/speed.md). The resident size stays at
 // its peak instead of falling back. Returns false if glibc refused either setting.
 bool KeepFreedMemory();
 

@@ -108,7 +108,8 @@ TrackerParams Threads(int n) {
 
 // Times Tracker::AddScan of each scan after a warm-up of `warmup` scans; one iteration per scan
 // (the tracker is rebuilt and warmed up, untimed, when the sequence runs out).
-// period_ms > 0: each timed scan starts that long after the one before (the wait untimed).
+// period_ms > 0: each scan, warm-up scans too, starts that long after the one before (the wait
+// untimed), so that the first timed scan comes as long after the warm-up as on the bus.
 void RunSequence(benchmark::State& state, const Sequence& seq, int warmup, bool breakdown,
                  const TrackerParams& params = Threads(1), int period_ms = 0) {
   if (!seq.error.empty()) {
@@ -128,12 +129,18 @@ void RunSequence(benchmark::State& state, const Sequence& seq, int warmup, bool 
   std::vector<double> cpu_ms, wall_ms, pre_ms, seg_ms, assoc_ms, rest_ms;
   double points = 0, tracks = 0;
   auto next_start = std::chrono::steady_clock::now();
+  const auto wait_for_start = [&] {
+    if (period_ms <= 0) return;
+    std::this_thread::sleep_until(next_start);
+    next_start = std::chrono::steady_clock::now() + std::chrono::milliseconds(period_ms);
+  };
   for (auto _ : state) {
     if (i >= seq.scans.size()) {
       tracker = std::make_unique<Tracker>(params);
       for (i = 0; i < static_cast<std::size_t>(warmup); ++i) {
         for (const auto& p : seq.poses_before[i]) tracker->AddPose(p, &out);
         LadarScan copy = seq.scans[i];
+        wait_for_start();
         tracker->AddScan(std::move(copy), &out);
       }
     }
@@ -142,10 +149,7 @@ void RunSequence(benchmark::State& state, const Sequence& seq, int warmup, bool 
     LadarScan copy = seq.scans[i];
     points += static_cast<double>(copy.size());
     out.clear();
-    if (period_ms > 0) {
-      std::this_thread::sleep_until(next_start);
-      next_start = std::chrono::steady_clock::now() + std::chrono::milliseconds(period_ms);
-    }
+    wait_for_start();
     const double w0 = WallSeconds(), c0 = ProcessCpuSeconds();
     tracker->AddScan(std::move(copy), &out);  // processed here: its poses are in
     const double c1 = ProcessCpuSeconds(), w1 = WallSeconds();

@@ -34,7 +34,7 @@ namespace vtrack {
 // between sweeps gets little from its second thread on a 2-CPU machine: the worker, woken after
 // ~90 ms asleep, is placed on the CPU of the thread that woke it (Linux's wake-affine
 // placement), and the two run one after the other until the scheduler moves one
-// (docs/results.md, "Speed"). With more CPUs than threads nothing is pinned: the scheduler then
+// (docs/speed.md). With more CPUs than threads nothing is pinned: the scheduler then
 // finds an idle CPU, and pinning to fixed ones (CPU 0 takes most interrupts) could only hurt.
 // A refused pin is ignored, and so is another thread calling later.
 class WorkerPool {

@@ -1,6 +1,7 @@
 #include "tracker/core/tracker.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -40,6 +41,12 @@ bool TrackerParams::Validate(std::string* error) const {
   return problem.empty();
 }
 
+namespace {
+std::atomic<bool> thread_pinning_allowed{false};
+}  // namespace
+
+void Tracker::AllowThreadPinning(bool allow) { thread_pinning_allowed.store(allow); }
+
 Tracker::Tracker(const TrackerParams& params, bool debug)
     : params_(params),
       debug_(debug),
@@ -61,7 +68,8 @@ Tracker::Tracker(const TrackerParams& params, bool debug)
     column_top_used_[three_d ? 1 : 0] =
         UsesFeature(params_.evidence, three_d, EvidenceFeature::kColumnTop);
   }
-  pool_ = std::make_unique<WorkerPool>(params_.compute.threads, params_.compute.pin_threads);
+  pool_ = std::make_unique<WorkerPool>(params_.compute.threads,
+                                       params_.compute.pin_threads && thread_pinning_allowed.load());
   preprocessor_.SetPool(pool_.get());
   associator_.SetPool(pool_.get());
   for (int k = 0; k < params_.compute.threads; ++k) {

@@ -71,6 +71,13 @@ class Tracker {
   // Throws std::invalid_argument naming the first invalid parameter.
   explicit Tracker(const TrackerParams& params, bool debug = false);
 
+  // Whether trackers made from now on in this process may pin their threads to CPUs
+  // (compute.pin_threads; off until allowed). Where threads run is the process's to decide:
+  // vtrack-tracker allows it when it runs live; a program that builds a Tracker itself (a test,
+  // a benchmark, an application with threads of its own) keeps its threads where they are unless
+  // it allows it too.
+  static void AllowThreadPinning(bool allow);
+
   // Each may process queued scans; their outputs are appended to *out in scan order.
   void AddPose(const EgoPose& pose, std::vector<ScanOutput>* out);
   void AddScan(LadarScan&& scan, std::vector<ScanOutput>* out);

@@ -10,10 +10,12 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
 #include <random>
 #include <set>
 #include <string>
 
+#include "tests/support/affinity.h"
 #include "tests/tracker/core/synthetic_scene.h"
 
 namespace vtrack {
@@ -280,6 +282,39 @@ TEST(TrackerTest, SameInputGivesIdenticalOutput) {
       EXPECT_EQ(a[i].tracks[j].theta, b[i].tracks[j].theta);
     }
   }
+}
+
+// Where threads run is the process's to decide (Tracker::AllowThreadPinning): a tracker built
+// with the shipped parameters leaves its caller's thread where it was, unless the process
+// allows pinning, as vtrack-tracker does live. The calling thread's CPUs as the kernel reports
+// them, after scans that ran the pool's loops.
+TEST(TrackerTest, PinsItsThreadsOnlyWhereTheProcessAllowsIt) {
+  const pthread_t self = pthread_self();
+  const std::vector<int> allowed = testing::AffinityOf(self);
+  const int n = static_cast<int>(allowed.size());
+  if (n < 2 || n > 64 || !testing::CanPinAThread(allowed[0])) {
+    GTEST_SKIP() << "the process may run on " << n << " CPUs, or may not pin a thread";
+  }
+  TrackerParams params;
+  ASSERT_TRUE(params.compute.pin_threads);  // shipped on
+  params.compute.threads = n;               // as many threads as CPUs: pinned where allowed
+  auto run = [&params](bool allow_pinning) {
+    Tracker::AllowThreadPinning(allow_pinning);
+    auto tracker = std::make_unique<Tracker>(params);
+    Tracker::AllowThreadPinning(false);  // decided when the tracker is made
+    SyntheticScene scene(SceneConfig{}, TwoCars(), 47);
+    EXPECT_FALSE(RunScene(tracker.get(), &scene, 1.0).empty());
+    return tracker;
+  };
+  {
+    const auto tracker = run(false);
+    EXPECT_EQ(testing::AffinityOf(self), allowed);
+  }
+  {
+    const auto tracker = run(true);
+    EXPECT_EQ(testing::AffinityOf(self), std::vector<int>{allowed[0]});
+  }
+  EXPECT_EQ(testing::AffinityOf(self), allowed);  // set free with the tracker
 }
 
 TEST(TrackerTest, AnyNumberOfThreadsGivesTheSameOutput) {

@@ -199,9 +199,12 @@ void BM_TrackerScan_Kitti_2Threads(benchmark::State& state) {
   RunSequence(state, bench::Kitti(), 10, false, params);
 }
 void BM_TrackerScan_Kitti_2Threads_10Hz(benchmark::State& state) {
-  Tracker::AllowThreadPinning(true);  // as the live vtrack-tracker
+  // Pinned as the live vtrack-tracker (the permission taken back however the run ends).
+  struct Allowed {
+    Allowed() { Tracker::AllowThreadPinning(true); }
+    ~Allowed() { Tracker::AllowThreadPinning(false); }
+  } allowed;
   RunSequence(state, bench::Kitti(), 10, false, Threads(2), 100);
-  Tracker::AllowThreadPinning(false);
 }
 void BM_TrackerScan_Kitti_2Threads_10Hz_Unpinned(benchmark::State& state) {
   TrackerParams params = Threads(2);

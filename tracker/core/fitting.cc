@@ -628,11 +628,12 @@ Clear AngleBelow(const Eigen::Vector2d& u, const Eigen::Vector2d& v, double tan_
 }
 
 // std::tan(limit), kept for the last limit asked on this thread: the fits ask for the one limit
-// of their parameters a few thousand times a scan (std::tan was ~1 % of a KITTI scan's time).
+// of their parameters a few thousand times a scan (std::tan on every call would be ~1 % of a
+// KITTI scan's time). Any other limit (NaN, or a zero of the other sign) is computed anew.
 double TanOf(double limit) {
   thread_local double last_limit = std::numeric_limits<double>::quiet_NaN();
   thread_local double last_tan = 0.0;
-  if (!(limit == last_limit)) {
+  if (!(limit == last_limit) || std::signbit(limit) != std::signbit(last_limit)) {
     last_tan = std::tan(limit);
     last_limit = limit;
   }

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "base/angle.h"
+#include "tracker/core/range_profile.h"
 #include "tracker/core/return_kernels.h"
 
 namespace vtrack {
@@ -93,6 +94,8 @@ struct Context : internal::PerpNoise {
   int n = 0;
   Eigen::Vector2d origin = Eigen::Vector2d::Zero();  // world position of the local frame
   Eigen::Vector2d sensor = Eigen::Vector2d::Zero();  // local
+  const RangeProfile* profile = nullptr;             // see FitRequest
+  Eigen::Vector2d profile_origin = Eigen::Vector2d::Zero();  // world position of local 0
 
   Eigen::Vector2d P(int i) const { return {px[i], py[i]}; }
   Eigen::Vector2d RayAt(int i) const { return {rx[i], ry[i]}; }
@@ -186,8 +189,9 @@ std::uint64_t Classify(const Context& ctx, const Model& m, const std::int8_t* ma
 }
 
 // Keeps the largest run of edge k's inliers whose consecutive spacing along the edge is at most
-// max(max_gap, max_spacings * the median spacing); the others become outliers. Returns the kept
-// run's extent.
+// max(max_gap, max_spacings * the median spacing), and at most max_gap where the scan's range
+// profile (ctx.profile, 3-D scans) sees through the gap; the others become outliers. Returns the
+// kept run's extent.
 Extent GapFilter(const Context& ctx, const Model& m, int k, double max_gap, double max_spacings,
                  std::int8_t* labels, std::vector<double>* proj, std::vector<double>* gaps) {
   const Eigen::Vector2d along = (k == 0) ? m.U0() : m.U1();
@@ -200,15 +204,24 @@ Extent GapFilter(const Context& ctx, const Model& m, int k, double max_gap, doub
   std::sort(proj->begin(), proj->end());
   const std::vector<double>& s = *proj;
   const int n = static_cast<int>(s.size());
+  // A gap wider than max_gap that the sensor sees through (something farther seen in it, no
+  // return near the face: two cars of a parked row) is no run of missing returns, however wide
+  // the spacing: the run ends there.
+  const double seen_gap = max_gap;  // [m]
   if (n >= 3) {
     gaps->resize(n - 1);
     for (int i = 0; i + 1 < n; ++i) (*gaps)[i] = s[i + 1] - s[i];
     std::nth_element(gaps->begin(), gaps->begin() + (n - 1) / 2, gaps->end());
     max_gap = std::max(max_gap, max_spacings * (*gaps)[(n - 1) / 2]);
   }
+  const auto at = [&](double a) { return Eigen::Vector2d(ctx.profile_origin + m.c + along * a); };
+  const auto seen_through = [&](int i) {
+    return ctx.profile != nullptr && s[i] - s[i - 1] > seen_gap &&
+           ctx.profile->SeenThrough(at(s[i - 1]), at(s[i]), kEndOccluderMargin);
+  };
   int best_lo = 0, best_hi = 0, lo = 0;
   for (int i = 1; i <= n; ++i) {
-    if (i == n || s[i] - s[i - 1] > max_gap) {
+    if (i == n || s[i] - s[i - 1] > max_gap || seen_through(i)) {
       if (i - 1 - lo > best_hi - best_lo) {
         best_lo = lo;
         best_hi = i - 1;
@@ -1237,6 +1250,8 @@ Context MakeContext(const FitRequest& req, const FitParams& P, std::vector<doubl
   ctx.n = n;
   ctx.origin = Eigen::Vector2d(req.x[0], req.y[0]);
   ctx.sensor = req.sensor_xy - ctx.origin;
+  ctx.profile = req.profile;
+  ctx.profile_origin = req.profile_offset + ctx.origin;
   px->resize(n);
   py->resize(n);
   rx->resize(n);

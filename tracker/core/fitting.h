@@ -10,7 +10,8 @@
 //  2. On all points: inliers are the points within inlier_sigmas * sigma_perp of an edge (for a
 //     corner, of the edge's ray leaving the corner; a point near both goes to the nearer);
 //     inliers separated from the main run of their edge by a gap larger than max_inlier_gap_m and
-//     max_gap_spacings median spacings are dropped.
+//     max_gap_spacings median spacings are dropped, and so are those beyond a gap larger than
+//     max_inlier_gap_m that the scan's range profile sees through (FitRequest::profile).
 //     Then `gauss_newton_iterations` (paper: one) weighted Gauss-Newton steps on Eq. (16), and
 //     the inliers are classified again.
 //  3. Choice: the corner if each of its edges holds >= min_edge_inliers and
@@ -93,6 +94,8 @@
 
 namespace vtrack {
 
+class RangeProfile;
+
 enum class FitKind : std::int8_t { kNone = 0, kEdge = 1, kCorner = 2 };  // = track_debug FIT_*
 
 enum class FitFailure : std::int8_t {
@@ -125,6 +128,11 @@ struct FitRequest {
   double range_sigma_m = 0.03;            // [m] LADAR range noise (1 sigma), > 0
   double min_inside_fraction = 0.0;       // [-] in [0, 1]: share of points inside the rectangle
   std::uint64_t seed = 0;                 // RANSAC sampling; equal requests give equal results
+  // The scan's range profile (3-D scans; nullptr: none), in the world frame, and the world
+  // position of the origin of x and y. A gap along a face that the sensor sees through
+  // (RangeProfile::SeenThrough) ends the face's run of inliers.
+  const RangeProfile* profile = nullptr;
+  Eigen::Vector2d profile_offset = Eigen::Vector2d::Zero();  // [m]
 };
 
 struct FittedEdge {

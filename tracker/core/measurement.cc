@@ -64,6 +64,8 @@ bool TrackMeasurer::Measure(bool small, const PointSet& points, const Eigen::Vec
   req.range_sigma_m = params_.range_sigma;
   req.min_inside_fraction = h->inside_fraction;
   req.seed = seed;
+  req.profile = profile_;
+  req.profile_offset = points.origin;
   (points.outline ? outline_fitter_ : fitter_).Fit(req, &h->fit);
   if (h->fit.kind == FitKind::kNone) return false;
   h->has_fit = true;

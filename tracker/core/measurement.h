@@ -35,10 +35,14 @@ class TrackMeasurer {
 
   const FitParams& fit_params() const { return fitter_.params(); }
 
+  // The scan's range profile for the fits that follow (FitRequest::profile; nullptr: none).
+  void set_profile(const RangeProfile* profile) { profile_ = profile; }
+
  private:
   TrackManagerParams params_;
   SegmentFitter fitter_;
   SegmentFitter outline_fitter_;  // fitter_'s parameters with the outline_* overrides
+  const RangeProfile* profile_ = nullptr;
 };
 
 }  // namespace vtrack

@@ -260,7 +260,7 @@ struct FitParams {
     v("min_inlier_fraction", &min_inlier_fraction, {"-", Closed(0, 1), "least share of the segment's points that are inliers"});
     v("gauss_newton_iterations", &gauss_newton_iterations, {"-", Closed(0, 20), "weighted Gauss-Newton steps on Eq. 16 (paper: one)"});
     v("max_inlier_gap_m", &max_inlier_gap_m, {"m", Above(0), "inliers beyond a larger gap along an edge are dropped (parked rows: rear faces ~0.8 m apart)"});
-    v("max_gap_spacings", &max_gap_spacings, {"-", AtLeast(1), "... unless the gap is within this many median point spacings (missing returns)"});
+    v("max_gap_spacings", &max_gap_spacings, {"-", AtLeast(1), "... unless the gap is within this many median point spacings (missing returns) and, on 3-D scans, not seen through"});
     v("inside_margin_m", &inside_margin_m, {"m", AtLeast(0), "the rectangle grown by this for the inside fraction"});
     v("partial_view_sigmas", &partial_view_sigmas, {"-", AtLeast(0), "an extent shorter than the shape by more sigmas is a partial view"});
     v("variance_factor_sigmas", &variance_factor_sigmas, {"-", Finite(), "significance for scaling R by chi^2/dof (<= 0: never)"});

@@ -80,6 +80,33 @@ int RangeProfile::Bin(const Eigen::Vector2d& p) const {
   return ((b % n) + n) % n;
 }
 
+bool RangeProfile::SeenThrough(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                               double margin) const {
+  if (nearest_.empty()) return false;
+  const int n = num_bins_;
+  const int ba = Bin(a);
+  int d = ((Bin(b) - ba) % n + n) % n;
+  int step = 1;
+  if (d > n / 2) {
+    d = n - d;
+    step = -1;
+  }
+  if (d < 2) return false;
+  const float r = static_cast<float>(std::max((a - sensor_).norm(), (b - sensor_).norm()) + margin);
+  int behind = 0;
+  for (int k = 1; k < d; ++k) {
+    const int bin = (((ba + step * k) % n) + n) % n;
+    bool any = false;
+    for (int ring = 0; ring < num_rings_; ++ring) {
+      const float v = Nearest(ring, bin);
+      if (v < r) return false;
+      any = any || std::isfinite(v);
+    }
+    behind += any;
+  }
+  return 2 * behind >= d - 1;
+}
+
 void RangeProfile::MarkUnseen(double begin, double end) {
   const int n = num_bins_;
   if (n == 0) return;

@@ -44,6 +44,11 @@ class RangeProfile {
   // it); on every ring if none does.
   bool FreeBeyond(const Eigen::Vector2d& end, const Eigen::Vector2d& inner, double margin,
                   int bins) const;
+  // True if the sensor sees through the gap between a and b, two points of one face: every
+  // bearing bin strictly between theirs holds, on every ring, no return nearer than the farther
+  // of the two plus margin, and at least half of them hold a farther return (something seen
+  // behind the gap, not only dropouts). False if fewer than one bin lies between them.
+  bool SeenThrough(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double margin) const;
   // Marks the bins of world bearings from begin to end [rad] (counter-clockwise) as hidden on
   // every ring (a return at range 0): where the sweep's returns were lost, a face's end is not
   // seen, and the face must not be taken for a full view.

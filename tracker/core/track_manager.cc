@@ -103,6 +103,7 @@ void TrackManager::Update(std::size_t index, const PointSet& points,
                           TrackDebug* debug, const RangeProfile* profile,
                           TrackMeasurer* measurer) {
   if (measurer == nullptr) measurer = &measurer_;
+  measurer->set_profile(profile);
   Track& t = tracks_[index];
   t.seen_this_scan = true;
   const std::int64_t tm = std::max(points.mean_utime, t.state_utime);
@@ -424,7 +425,8 @@ double TrackManager::ObserveEvidence(std::size_t index, const ReturnEvidence& r,
 }
 
 bool TrackManager::Create(const PointSet& points, const Eigen::Vector2d& sensor_xy,
-                          std::uint64_t seed) {
+                          std::uint64_t seed, const RangeProfile* profile) {
+  measurer_.set_profile(profile);
   Track t;
   t.small_object = points.extent < params_.small_object_extent;
   TrackHypothesis h = FirstHypothesis();

@@ -141,7 +141,8 @@ class TrackManager {
   // Marks a track without returns on this scan.
   void Miss(std::size_t index);
   // A new track from returns that no track claimed. Returns false if they cannot be measured.
-  bool Create(const PointSet& points, const Eigen::Vector2d& sensor_xy, std::uint64_t seed);
+  bool Create(const PointSet& points, const Eigen::Vector2d& sensor_xy, std::uint64_t seed,
+              const RangeProfile* profile = nullptr);
   // Life cycle after a scan at utime: confirmation, coasting, deletion, duplicates.
   void EndScan(std::int64_t utime);
   // Every track, its reported hypothesis predicted to utime.

@@ -370,7 +370,9 @@ void Tracker::CreateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_
     Worker& w = workers_.front();
     w.outline.Extract(points_, idx, scan, sensor_xy, &w.point_set);
     if (w.point_set.size() == 0) continue;
-    if (manager_->Create(w.point_set, sensor_xy, RansacSeed(seed_, scan.utime, -1 - static_cast<std::int64_t>(k)))) {
+    if (manager_->Create(w.point_set, sensor_xy,
+                         RansacSeed(seed_, scan.utime, -1 - static_cast<std::int64_t>(k)),
+                         scan.num_rings > 1 ? &profile_ : nullptr)) {
       const std::size_t index = manager_->tracks().size() - 1;
       created_.Add(manager_->Box(index));
       ScanOutput::EvidenceRow row;

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "tests/tracker/core/synthetic_scan.h"
+#include "tracker/core/range_profile.h"
 #include "base/angle.h"
 #include "base/box.h"
 
@@ -1146,6 +1147,60 @@ TEST(Fitting, NewObjectsShortFaceSeenAtAGrazingAngleIsASide) {
   plain.Fit(req, &fit);
   ASSERT_EQ(fit.kind, FitKind::kEdge) << ToString(fit.failure);
   EXPECT_NEAR(axis_deg(fit.z.z()), 90.0, 2.0);
+}
+
+TEST(Fitting, GapSeenThroughEndsTheFace) {
+  // Two parked cars' faces 40 m ahead, a 4.5 m and a 3.5 m one, 1 m apart, returns every 0.25 m:
+  // the gap is within max_gap_spacings = 5 median spacings, so without the scan's range profile
+  // the fit bridges it. With a profile in which the rings above the cars see a wall 5 m behind
+  // the gap, the face ends at the gap; with nothing seen behind it (returns lost), it does not.
+  // The request's points are given about o, as the tracker gives them.
+  const Eigen::Vector2d o(40.0, 0.0);
+  std::vector<float> x, y;
+  std::vector<double> wx, wy;
+  std::vector<std::int16_t> ring;
+  for (const auto& [y0, y1] : {std::pair{0.5, 5.0}, std::pair{-4.0, -0.5}}) {
+    for (double v = y0; v <= y1 + 1e-9; v += 0.25) {
+      x.push_back(0.0f);
+      y.push_back(static_cast<float>(v));
+      for (int r = 30; r <= 35; ++r) {
+        wx.push_back(40.0);
+        wy.push_back(v);
+        ring.push_back(static_cast<std::int16_t>(r));
+      }
+    }
+  }
+  RangeProfile blind;
+  blind.Build(Eigen::Vector2d::Zero(), wx, wy, ring, 0.2);
+  for (double v = -6.0; v <= 6.0; v += 0.02) {
+    for (int r = 36; r <= 40; ++r) {
+      wx.push_back(45.0);
+      wy.push_back(v);
+      ring.push_back(static_cast<std::int16_t>(r));
+    }
+  }
+  RangeProfile wall;
+  wall.Build(Eigen::Vector2d::Zero(), wx, wy, ring, 0.2);
+  FitRequest req;
+  req.x = x;
+  req.y = y;
+  req.sensor_xy = -o;
+  req.profile_offset = o;
+  SegmentFitter fitter;
+  FitResult fit;
+  for (const RangeProfile* profile : std::vector<const RangeProfile*>{nullptr, &blind, &wall}) {
+    SCOPED_TRACE(profile == nullptr ? "none" : profile == &blind ? "nothing behind" : "wall");
+    req.profile = profile;
+    fitter.Fit(req, &fit);
+    ASSERT_EQ(fit.kind, FitKind::kEdge) << ToString(fit.failure);
+    if (profile == &wall) {
+      EXPECT_NEAR(fit.observed_length_m, 4.5, 0.3);  // the larger car's face alone
+      EXPECT_GT(fit.edges[0].end.y(), 0.4);
+      EXPECT_GT(fit.edges[0].start.y(), 0.4);
+    } else {
+      EXPECT_NEAR(fit.observed_length_m, 9.0, 0.3);  // both faces and the gap
+    }
+  }
 }
 
 }  // namespace

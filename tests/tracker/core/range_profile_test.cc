@@ -152,5 +152,63 @@ TEST(RangeProfileTest, BinsAreThoseOfStdAtan2AlsoOnBinEdges) {
   }
 }
 
+// SeenThrough: two parked cars' faces 40 m ahead with a 1 m gap between them (y -0.5 .. 0.5, 1.4
+// deg, 7 bins), hit by rings 30-35; the rings above them (36-40) see a wall 5 m behind.
+Cloud TwoCarsInARow(bool wall_behind) {
+  Cloud c;
+  c.Face(40.0, 0.5, 5.0, 30, 35);
+  c.Face(40.0, -4.0, -0.5, 30, 35);
+  if (wall_behind) c.Face(45.0, -6.0, 6.0, 36, 40);
+  return c;
+}
+const Eigen::Vector2d kGapLeft(40.0, 0.5), kGapRight(40.0, -0.5);
+
+TEST(RangeProfileTest, GapWithSomethingBehindItIsSeenThrough) {
+  const RangeProfile p = PerRing(TwoCarsInARow(true));
+  EXPECT_TRUE(p.SeenThrough(kGapLeft, kGapRight, kMargin));
+  EXPECT_TRUE(p.SeenThrough(kGapRight, kGapLeft, kMargin));
+  // Along one car's face there is no gap: its own returns fill the bins between.
+  EXPECT_FALSE(p.SeenThrough({40.0, 1.0}, {40.0, 4.0}, kMargin));
+}
+
+TEST(RangeProfileTest, GapShowingNothingBehindItIsNotSeenThrough) {
+  // No return at all in the gap: returns lost (dark paint, glass) look the same.
+  EXPECT_FALSE(PerRing(TwoCarsInARow(false)).SeenThrough(kGapLeft, kGapRight, kMargin));
+}
+
+TEST(RangeProfileTest, GapWithAReturnNearTheFaceOrNearerIsNotSeenThrough) {
+  for (const double at : {40.3, 20.0}) {  // within the margin behind the face; a pole in front
+    SCOPED_TRACE(at);
+    Cloud c = TwoCarsInARow(true);
+    c.Add(at, 0.0, 33);
+    EXPECT_FALSE(PerRing(c).SeenThrough(kGapLeft, kGapRight, kMargin));
+  }
+}
+
+TEST(RangeProfileTest, AtLeastHalfTheGapMustShowSomethingBehind) {
+  for (const auto& [from, seen] : {std::pair{0.3, false}, std::pair{-0.2, true}}) {
+    SCOPED_TRACE(from);
+    Cloud c = TwoCarsInARow(false);
+    c.Face(45.0, from * 45.0 / 40.0, 0.6 * 45.0 / 40.0, 36, 40);  // behind the gap's part from..0.5
+    EXPECT_EQ(PerRing(c).SeenThrough(kGapLeft, kGapRight, kMargin), seen);
+  }
+}
+
+TEST(RangeProfileTest, GapWithinOneBinIsNotSeenThrough) {
+  const RangeProfile p = PerRing(TwoCarsInARow(true));
+  EXPECT_FALSE(p.SeenThrough({40.0, 0.02}, {40.0, -0.02}, kMargin));
+}
+
+TEST(RangeProfileTest, GapAcrossTheBearingOfMinus180DegIsSeenThrough) {
+  // The scene turned by 180 deg: the gap straddles the first and last bins.
+  Cloud c = TwoCarsInARow(true);
+  for (std::size_t i = 0; i < c.x.size(); ++i) {
+    c.x[i] = -c.x[i];
+    c.y[i] = -c.y[i];
+  }
+  EXPECT_TRUE(PerRing(c).SeenThrough(-kGapLeft, -kGapRight, kMargin));
+  EXPECT_FALSE(PerRing(c).SeenThrough({-40.0, -1.0}, {-40.0, -4.0}, kMargin));
+}
+
 }  // namespace
 }  // namespace vtrack

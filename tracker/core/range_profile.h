@@ -1,5 +1,6 @@
 // The scan's range profile: the nearest return per bearing around the sensor, per ring. The
-// orientation rules ask it whether a fitted face was seen whole (track_manager.h).
+// orientation rules ask it whether a fitted face was seen whole (track_manager.h), the fit
+// whether a gap along a face is seen through (fitting.h).
 #pragma once
 
 #include <Eigen/Core>
@@ -47,7 +48,9 @@ class RangeProfile {
   // True if the sensor sees through the gap between a and b, two points of one face: every
   // bearing bin strictly between theirs holds, on every ring, no return nearer than the farther
   // of the two plus margin, and at least half of them hold a farther return (something seen
-  // behind the gap, not only dropouts). False if fewer than one bin lies between them.
+  // behind the gap, not only dropouts). False if no whole bin lies between them. Every ring
+  // counts, unlike FreeBeyond: a low object near the sensor that only other rings hit keeps the
+  // gap closed (the fit then bridges it, as without a profile).
   bool SeenThrough(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double margin) const;
   // Marks the bins of world bearings from begin to end [rad] (counter-clockwise) as hidden on
   // every ring (a return at range 0): where the sweep's returns were lost, a face's end is not

@@ -123,7 +123,8 @@ class TrackManager {
   void Predict(std::int64_t utime, std::vector<PredictedObject>* out) const;
 
   // Updates track index with its returns; debug (optional) is filled for the scan's debug.
-  // profile (optional): the scan's nearest range per bearing, for the full-view test of faces.
+  // profile (optional, 3-D scans): the scan's nearest range per bearing, for the full-view test
+  // of faces and the fits' see-through test of gaps (FitRequest::profile).
   // measurer (optional): the fitter to use (its buffers are scratch); updates of different
   // tracks may run at once on different threads, each with its own (NewMeasurer), and give the
   // same results as one after the other.
@@ -141,6 +142,7 @@ class TrackManager {
   // Marks a track without returns on this scan.
   void Miss(std::size_t index);
   // A new track from returns that no track claimed. Returns false if they cannot be measured.
+  // profile (optional, 3-D scans): as for Update, for the fit's see-through test of gaps.
   bool Create(const PointSet& points, const Eigen::Vector2d& sensor_xy, std::uint64_t seed,
               const RangeProfile* profile = nullptr);
   // Life cycle after a scan at utime: confirmation, coasting, deletion, duplicates.

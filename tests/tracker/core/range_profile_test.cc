@@ -186,17 +186,30 @@ TEST(RangeProfileTest, GapWithAReturnNearTheFaceOrNearerIsNotSeenThrough) {
 }
 
 TEST(RangeProfileTest, AtLeastHalfTheGapMustShowSomethingBehind) {
-  for (const auto& [from, seen] : {std::pair{0.3, false}, std::pair{-0.2, true}}) {
-    SCOPED_TRACE(from);
+  // The gap's ends lie in bins 896 and 903 (bearings -0.72 and +0.72 deg): six bins between,
+  // three of them (900-902) at bearings 0-0.6 deg. A wall behind the gap from bearing `from` on.
+  for (const auto& [from_deg, seen] :
+       {std::pair{0.0015, true}, std::pair{0.21, false}, std::pair{-0.5, true}}) {
+    SCOPED_TRACE(from_deg);
     Cloud c = TwoCarsInARow(false);
-    c.Face(45.0, from * 45.0 / 40.0, 0.6 * 45.0 / 40.0, 36, 40);  // behind the gap's part from..0.5
+    c.Face(45.0, 45.0 * std::tan(DegToRad(from_deg)), 45.0 * std::tan(DegToRad(1.0)), 36, 40);
     EXPECT_EQ(PerRing(c).SeenThrough(kGapLeft, kGapRight, kMargin), seen);
   }
 }
 
-TEST(RangeProfileTest, GapWithinOneBinIsNotSeenThrough) {
+TEST(RangeProfileTest, GapMustHoldAWholeBin) {
+  // Ends in neighbouring bins (899, 900): nothing between. Ends two bins apart (898, 900): bin
+  // 899 between, and the wall seen in it.
   const RangeProfile p = PerRing(TwoCarsInARow(true));
-  EXPECT_FALSE(p.SeenThrough({40.0, 0.02}, {40.0, -0.02}, kMargin));
+  auto at_deg = [](double deg) { return Eigen::Vector2d(40.0, 40.0 * std::tan(DegToRad(deg))); };
+  EXPECT_FALSE(p.SeenThrough(at_deg(0.03), at_deg(-0.03), kMargin));
+  EXPECT_TRUE(p.SeenThrough(at_deg(0.1), at_deg(-0.3), kMargin));
+}
+
+TEST(RangeProfileTest, GapWhereTheSweepLostItsReturnsIsNotSeenThrough) {
+  RangeProfile p = PerRing(TwoCarsInARow(true));
+  p.MarkUnseen(DegToRad(-0.1), DegToRad(0.1));
+  EXPECT_FALSE(p.SeenThrough(kGapLeft, kGapRight, kMargin));
 }
 
 TEST(RangeProfileTest, GapAcrossTheBearingOfMinus180DegIsSeenThrough) {

@@ -733,6 +733,9 @@ void CheckRequest(const FitRequest& r) {
   } else if (r.predicted_center && !r.predicted_center->allFinite()) {
     os << "FitRequest.predicted_center = (" << r.predicted_center->x() << ", "
        << r.predicted_center->y() << "): must be finite";
+  } else if (!r.profile_offset.allFinite()) {
+    os << "FitRequest.profile_offset = (" << r.profile_offset.x() << ", " << r.profile_offset.y()
+       << "): must be finite";
   } else if (!(r.range_sigma_m > 0.0 && std::isfinite(r.range_sigma_m))) {
     os << "FitRequest.range_sigma_m = " << r.range_sigma_m << ": must be > 0";
   } else if (!(r.min_inside_fraction >= 0.0 && r.min_inside_fraction <= 1.0)) {

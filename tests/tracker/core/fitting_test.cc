@@ -885,6 +885,9 @@ TEST(Fitting, BadInputIsReportedNotCrashed) {
   r = req;
   r.predicted_theta = INFINITY;
   expect_throw(r, "predicted_theta = inf");
+  r = req;
+  r.profile_offset.y() = NAN;
+  expect_throw(r, "profile_offset");
 
   // Bad data: reasons, no throw.
   std::vector<float> bx = x;

@@ -29,9 +29,10 @@ DimensionHistogram::DimensionHistogram(const ShapeParams& params) : params_(para
   }
 }
 
-bool DimensionHistogram::Add(double time_s, double value_m) {
+bool DimensionHistogram::Add(double time_s, double value_m, double sample_weight) {
   if (!std::isfinite(time_s) || !std::isfinite(value_m) || value_m <= 0.0) return false;
-  double weight = 1.0;
+  if (!(sample_weight > 0.0 && std::isfinite(sample_weight))) return false;
+  double weight = sample_weight;
   if (empty_) {
     newest_time_ = time_s;
     empty_ = false;
@@ -47,7 +48,7 @@ bool DimensionHistogram::Add(double time_s, double value_m) {
     }
     newest_time_ = time_s;
   } else {
-    weight = std::exp2(-(newest_time_ - time_s) / params_.half_life);
+    weight = sample_weight * std::exp2(-(newest_time_ - time_s) / params_.half_life);
   }
   if (value_m > params_.max_dimension) {
     overflow_ += weight;
@@ -64,6 +65,12 @@ bool DimensionHistogram::Add(double time_s, double value_m) {
   }
   total_ += weight;
   return true;
+}
+
+double DimensionSampleWeight(double std_m, double floor_std_m) {
+  if (!(std_m > 0.0 && std::isfinite(std_m))) return 1.0;
+  const double r = floor_std_m / std_m;
+  return std::min(1.0, r * r);
 }
 
 double DimensionHistogram::TotalWeight(double time_s) const {

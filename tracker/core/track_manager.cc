@@ -193,7 +193,7 @@ bool TrackManager::UpdateHypothesis(const Track& t, bool parked, const PointSet&
                         h, &m);
   if (ApplyMeasurement(measured ? &m : nullptr, h) ||
       (measured && RestartLostStill(t, points, m, h))) {
-    ObserveShape(t.small_object, points, time_s, h);
+    ObserveShape(t.small_object, points, time_s, measurer->profile() != nullptr, h);
   }
   return h->updated_this_scan;
 }
@@ -245,7 +245,7 @@ bool TrackManager::ApplyMeasurement(const CentreMeasurement* m, TrackHypothesis*
 }
 
 void TrackManager::ObserveShape(bool small, const PointSet& points, double time_s,
-                                TrackHypothesis* h) const {
+                                bool three_d, TrackHypothesis* h) const {
   if (small) {
     // Extent of the returns along and across the estimated heading.
     const double th = h->filter.x(ekf_.model(h->filter.kind).PoseIndices()[2]);
@@ -261,8 +261,7 @@ void TrackManager::ObserveShape(bool small, const PointSet& points, double time_
     h->shape.AddLength(time_s, std::max(kMinObservedExtent, a1 - a0));
     h->shape.AddWidth(time_s, std::max(kMinObservedExtent, n1 - n0));
   } else if (h->has_fit) {
-    if (std::isfinite(h->fit.observed_length_m)) h->shape.AddLength(time_s, h->fit.observed_length_m);
-    if (std::isfinite(h->fit.observed_width_m)) h->shape.AddWidth(time_s, h->fit.observed_width_m);
+    ObserveFitDimensions(time_s, three_d, h);
     h->length_seen_full = h->length_seen_full || h->fit.length_full_view;
     h->width_seen_full = h->width_seen_full || h->fit.width_full_view;
   }
@@ -437,13 +436,27 @@ bool TrackManager::Create(const PointSet& points, const Eigen::Vector2d& sensor_
   }
   if (!m.z.allFinite() || !m.R.allFinite()) return false;
   StartFilter(m, &h);
-  ObserveFirstShape(t.small_object, points, &h);
+  ObserveFirstShape(t.small_object, points, profile != nullptr, &h);
   SnapshotReturns(points, &t.last_returns);
   AddTrack(std::move(t), std::move(h), points.mean_utime);
   return true;
 }
 
-void TrackManager::ObserveFirstShape(bool small, const PointSet& points, TrackHypothesis* h) const {
+void TrackManager::ObserveFitDimensions(double time_s, bool three_d, TrackHypothesis* h) const {
+  const FitResult& f = h->fit;
+  auto weight = [&](double std_m) {
+    return three_d ? DimensionSampleWeight(std_m, params_.range_sigma) : 1.0;
+  };
+  if (std::isfinite(f.observed_length_m)) {
+    h->shape.AddLength(time_s, f.observed_length_m, weight(f.observed_length_std_m));
+  }
+  if (std::isfinite(f.observed_width_m)) {
+    h->shape.AddWidth(time_s, f.observed_width_m, weight(f.observed_width_std_m));
+  }
+}
+
+void TrackManager::ObserveFirstShape(bool small, const PointSet& points, bool three_d,
+                                     TrackHypothesis* h) const {
   const double time_s = static_cast<double>(points.mean_utime) * 1e-6;
   if (small) {
     // Axis-aligned extents (theta = 0 for a centroid measurement).
@@ -457,8 +470,7 @@ void TrackManager::ObserveFirstShape(bool small, const PointSet& points, TrackHy
     h->shape.AddLength(time_s, std::max(kMinObservedExtent, static_cast<double>(x1 - x0)));
     h->shape.AddWidth(time_s, std::max(kMinObservedExtent, static_cast<double>(y1 - y0)));
   } else if (h->has_fit) {
-    if (std::isfinite(h->fit.observed_length_m)) h->shape.AddLength(time_s, h->fit.observed_length_m);
-    if (std::isfinite(h->fit.observed_width_m)) h->shape.AddWidth(time_s, h->fit.observed_width_m);
+    ObserveFitDimensions(time_s, three_d, h);
     h->length_seen_full = h->fit.length_full_view;
     h->width_seen_full = h->fit.width_full_view;
   }

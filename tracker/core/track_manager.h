@@ -124,7 +124,8 @@ class TrackManager {
 
   // Updates track index with its returns; debug (optional) is filled for the scan's debug.
   // profile (optional, 3-D scans): the scan's nearest range per bearing, for the full-view test
-  // of faces and the fits' see-through test of gaps (FitRequest::profile).
+  // of faces and the fits' see-through test of gaps (FitRequest::profile); given, the fits'
+  // dimensions are weighted by how well they were seen (ObserveFitDimensions).
   // measurer (optional): the fitter to use (its buffers are scratch); updates of different
   // tracks may run at once on different threads, each with its own (NewMeasurer), and give the
   // same results as one after the other.
@@ -142,7 +143,7 @@ class TrackManager {
   // Marks a track without returns on this scan.
   void Miss(std::size_t index);
   // A new track from returns that no track claimed. Returns false if they cannot be measured.
-  // profile (optional, 3-D scans): as for Update, for the fit's see-through test of gaps.
+  // profile (optional, 3-D scans): as for Update (the see-through test, weighted dimensions).
   bool Create(const PointSet& points, const Eigen::Vector2d& sensor_xy, std::uint64_t seed,
               const RangeProfile* profile = nullptr);
   // Life cycle after a scan at utime: confirmation, coasting, deletion, duplicates.
@@ -183,12 +184,22 @@ class TrackManager {
   bool UpdateHypothesis(const Track& t, bool parked, const PointSet& points,
                         const Eigen::Vector2d& sensor_xy, std::uint64_t seed, double time_s,
                         TrackMeasurer* measurer, TrackHypothesis* h);
-  // The shape estimate's observations after an accepted update, and on creation.
-  void ObserveShape(bool small, const PointSet& points, double time_s, TrackHypothesis* h) const;
+  // The shape estimate's observations after an accepted update, and on creation. three_d: the
+  // returns come from a 3-D scan (a profile was given), whose fits' dimensions are weighted.
+  void ObserveShape(bool small, const PointSet& points, double time_s, bool three_d,
+                    TrackHypothesis* h) const;
+  // The fit's observed length and width (h->fit). On 3-D scans each is weighted by how well its
+  // ends were seen (DimensionSampleWeight, the range noise range_sigma as the best): the long
+  // side of a car seen at a grazing angle from a few returns no longer outweighs dense views of
+  // it, and by the longest-peak rule sets the length. On single-plane scans every one weighs 1:
+  // their vehicle evidence model was fitted to the lengths of unweighted histograms, and weighted,
+  // clutter there grows lengths it calls vehicles (docs/design.md, note 8).
+  void ObserveFitDimensions(double time_s, bool three_d, TrackHypothesis* h) const;
   // The restart of a lost still object (above); returns whether h was restarted from m.
   bool RestartLostStill(const Track& t, const PointSet& points, const CentreMeasurement& m,
                         TrackHypothesis* h) const;
-  void ObserveFirstShape(bool small, const PointSet& points, TrackHypothesis* h) const;
+  void ObserveFirstShape(bool small, const PointSet& points, bool three_d,
+                         TrackHypothesis* h) const;
   // After the hypotheses' updates at utime (any: one was accepted): counts, the reported
   // hypothesis, re-seeding, the mover test. points: the returns that measured it (nullptr: a
   // detector's box).

@@ -521,7 +521,9 @@ INSTANTIATE_TEST_SUITE_P(Modes, MovingTruckTest,
 // The manager hands the scan's range profile to the fits of Create and Update: two parked cars'
 // faces 40 m ahead, 4.5 m and 3.5 m long, 1 m apart, returns every 0.25 m (5 spacings bridge
 // the gap), the rings above them seeing a wall 5 m behind the gap. With the profile each fit
-// measures the larger car's face alone; without it, both faces and the gap.
+// measures the larger car's face alone; without it, both faces and the gap. A profile marks a
+// 3-D scan, whose fits' lengths enter the shape's histogram weighted by how well their ends were
+// seen (DimensionSampleWeight against range_sigma); without one, each weighs 1.
 TEST(ParkedTrackTest, ManagerGivesTheRangeProfileToItsFits) {
   PointSet p;
   p.origin = Eigen::Vector2d(40.0, 0.0);
@@ -555,12 +557,25 @@ TEST(ParkedTrackTest, ManagerGivesTheRangeProfileToItsFits) {
     ASSERT_TRUE(s.m.Create(p, s.sensor, 1, given));
     ASSERT_TRUE(s.m.tracks()[0].hyps[0].has_fit);
     EXPECT_NEAR(s.m.tracks()[0].hyps[0].fit.observed_length_m, face_length, 0.3);
+    // The weight of a sample: 1 on a single-plane scan, else from the fit's uncertainty.
+    auto weight_of = [&](const FitResult& f) {
+      return given ? std::min(1.0, std::pow(s.params.range_sigma / f.observed_length_std_m, 2))
+                   : 1.0;
+    };
+    const double w0 = weight_of(s.m.tracks()[0].hyps[0].fit);
+    const double t0 = static_cast<double>(s.t) * 1e-6;
+    EXPECT_DOUBLE_EQ(s.m.tracks()[0].hyps[0].shape.length_histogram().TotalWeight(t0), w0);
+    if (given) EXPECT_LT(w0, 0.5);  // ends 0.25 m apart, known to about a spacing
     s.m.EndScan(s.t);
     s.t += kStep;
     p.mean_utime = s.t;
     s.m.Update(0, p, s.sensor, 2, nullptr, given, &worker);
     ASSERT_TRUE(s.m.tracks()[0].hyps[0].has_fit);
     EXPECT_NEAR(s.m.tracks()[0].hyps[0].fit.observed_length_m, face_length, 0.3);
+    const double t1 = static_cast<double>(s.t) * 1e-6;
+    const double decay = std::exp2(-(t1 - t0) / ShapeParams().half_life);
+    EXPECT_NEAR(s.m.tracks()[0].hyps[0].shape.length_histogram().TotalWeight(t1),
+                w0 * decay + weight_of(s.m.tracks()[0].hyps[0].fit), 1e-12);
   }
 }
 

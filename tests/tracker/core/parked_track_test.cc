@@ -565,7 +565,9 @@ TEST(ParkedTrackTest, ManagerGivesTheRangeProfileToItsFits) {
     const double w0 = weight_of(s.m.tracks()[0].hyps[0].fit);
     const double t0 = static_cast<double>(s.t) * 1e-6;
     EXPECT_DOUBLE_EQ(s.m.tracks()[0].hyps[0].shape.length_histogram().TotalWeight(t0), w0);
-    if (given) EXPECT_LT(w0, 0.5);  // ends 0.25 m apart, known to about a spacing
+    if (given) {
+      EXPECT_LT(w0, 0.5);  // ends 0.25 m apart, known to about a spacing
+    }
     s.m.EndScan(s.t);
     s.t += kStep;
     p.mean_utime = s.t;

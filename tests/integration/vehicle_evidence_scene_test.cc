@@ -256,10 +256,8 @@ TEST(VehicleEvidenceTest, RecordingTheRowsLeavesTheTracksAsTheyAre) {
 
 // Fails today, kept to be run by hand (--gtest_also_run_disabled_tests): pieces of the hedge row
 // (segments of 1-4 m, car height, 20-40 m away) gain vehicle evidence (200 of 301 confirmed
-// reports on it classed vehicle); the tree (0 of 184) and the wall (0 of 156) do not. Before the
-// shape weighed its lengths by how well they were seen (docs/design.md, note 8) the tree did, in
-// 33 of 156: close by, the scanner's highest beam passes under its crown and it looks no taller
-// than a van.
+// reports on it classed vehicle); the tree (0 of 184) and the wall (0 of 156) do not
+// (docs/design.md, section 4.10a).
 // Their returns scatter 3-8 cm off a surface against the car's 1 cm (the roughness feature), but
 // the shipped evidence model predates that feature (docs/design.md, section 4.10a).
 TEST(VehicleEvidenceTest, DISABLED_WallHedgeRowAndTreeNeverBecomeVehicles) {

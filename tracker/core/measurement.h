@@ -37,7 +37,6 @@ class TrackMeasurer {
 
   // The scan's range profile for the fits that follow (FitRequest::profile; nullptr: none).
   void set_profile(const RangeProfile* profile) { profile_ = profile; }
-  const RangeProfile* profile() const { return profile_; }
 
  private:
   TrackManagerParams params_;

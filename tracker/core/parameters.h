@@ -475,7 +475,7 @@ struct TrackManagerParams {
     v("parked_coast_max_s", &parked_coast_max_s, {"s", Above(0), "... a parked one (no mover, slower than mover_min_speed) at most this long"});
     v("max_position_std", &max_position_std, {"m", Above(0), "tracks less certain than this are deleted"});
     v("duplicate_overlap", &duplicate_overlap, {"-", OpenClosed(0, 1), "overlap (of the smaller rectangle) that makes two tracks duplicates"});
-    v("range_sigma", &range_sigma, {"m", Above(0), "LADAR range noise for fitting (Eq. 18's sigma); on 3-D scans also the best uncertainty of a fitted length or width, against which the shape weighs each (docs/design.md, note 8)"});
+    v("range_sigma", &range_sigma, {"m", Above(0), "LADAR range noise for fitting (Eq. 18's sigma); on 3-D scans also the uncertainty at or below which a fitted length or width counts as one whole sample of the shape's histogram (docs/design.md, note 8)"});
     v("outline_min_slant_deg", &outline_min_slant_deg, {"deg", ClosedOpen(0, 45), "3-D outline fit: least angle of a face to the ray"});
     v("outline_min_points", &outline_min_points, {"-", AtLeast(3), "3-D outline fit: least points"});
     v("outline_min_edge_inliers", &outline_min_edge_inliers, {"-", AtLeast(3), "3-D outline fit: least inliers of an edge (<= outline_min_points)"});

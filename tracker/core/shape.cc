@@ -68,7 +68,8 @@ bool DimensionHistogram::Add(double time_s, double value_m, double sample_weight
 }
 
 double DimensionSampleWeight(double std_m, double floor_std_m) {
-  if (!(std_m > 0.0 && std::isfinite(std_m))) return 1.0;
+  if (std::isinf(std_m)) return 0.0;
+  if (!(std_m > 0.0)) return 1.0;  // NaN or <= 0: not known
   const double r = floor_std_m / std_m;
   return std::min(1.0, r * r);
 }

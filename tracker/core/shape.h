@@ -19,7 +19,8 @@
 // half_life * log2(1 + min_peak_fraction), 0.32 half-lives at the default); a size that shrinks
 // is followed only when the old peak has decayed below min_peak_fraction of the new one, after
 // half_life * log2((1 + f) / f) (2.3 half-lives at f = 0.25), since a shorter peak looks just
-// like an occluded view.
+// like an occluded view. These times are for samples of equal weight: where the new samples weigh
+// w times as much as the old ones (Add's sample_weight), add about half_life * log2(1 / w).
 #pragma once
 
 #include <optional>
@@ -60,13 +61,15 @@ class DimensionHistogram {
   bool empty_ = true;
 };
 
-// The weight of a dimension measurement whose value is known to std_m [m] (1 sigma) where the
-// best measurement is known to floor_std_m [m]: min(1, (floor_std_m / std_m)^2), the inverse of
-// its variance relative to the best one's. A face seen densely end to end weighs 1; the long side
-// of a car seen at a grazing angle, a few returns 0.5-1 m apart whose ends are each uncertain by
-// a spacing, weighs a few hundredths, so that a handful of such views do not make a peak of
-// their own and, by the longest-peak rule, the estimate (a 6 m length on a 4.5 m car). 1 if
-// std_m is not finite or <= 0 (not known).
+// The weight of a dimension measurement whose value is known to std_m [m] (1 sigma):
+// min(1, (floor_std_m / std_m)^2), its inverse variance relative to that of a measurement known
+// to floor_std_m [m], which counts as one whole sample (as does any better one). The histogram
+// reads only ratios of weights, so floor_std_m sets nothing but that cap. A face seen densely
+// end to end weighs about 1; the long side of a car seen at a grazing angle, a few returns
+// 0.5-1 m apart whose ends are each uncertain by about a spacing, weighs a hundredth or less, so
+// that a handful of such views make no peak of their own and, by the longest-peak rule, no
+// estimate (a 6 m length on a 4.5 m car). 1 if std_m is NaN or <= 0 (not known); 0 if it is
+// infinite (nothing known: Add refuses the sample).
 double DimensionSampleWeight(double std_m, double floor_std_m);
 
 // Length and width of one tracked object.

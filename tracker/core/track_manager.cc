@@ -116,7 +116,7 @@ void TrackManager::Update(std::size_t index, const PointSet& points,
   if (t.small_object && points.extent >= params_.small_object_grown_extent) {
     GrowIntoRectangle(points, sensor_xy, seed, measurer, &t);
   }
-  const bool any = UpdateHypotheses(points, sensor_xy, seed, tm, measurer, &t);
+  const bool any = UpdateHypotheses(points, sensor_xy, seed, tm, profile != nullptr, measurer, &t);
   AfterUpdate(any, tm, /*pose_measured=*/false, &points, &t);
   SnapshotReturns(points, &t.last_returns);
   if (any && !t.mover && !t.small_object && profile && !profile->empty()) {
@@ -165,7 +165,7 @@ void TrackManager::GrowIntoRectangle(const PointSet& points, const Eigen::Vector
 }
 
 bool TrackManager::UpdateHypotheses(const PointSet& points, const Eigen::Vector2d& sensor_xy,
-                                    std::uint64_t seed, std::int64_t utime,
+                                    std::uint64_t seed, std::int64_t utime, bool three_d,
                                     TrackMeasurer* measurer, Track* t) {
   // A parked car's partial face is placed along itself where predicted (FitRequest::
   // predicted_center). Not a mover's: the same view of a mover does not repeat scan after scan,
@@ -174,14 +174,16 @@ bool TrackManager::UpdateHypotheses(const PointSet& points, const Eigen::Vector2
   const double time_s = static_cast<double>(utime) * 1e-6;
   bool any = false;
   for (TrackHypothesis& h : t->hyps) {
-    any = UpdateHypothesis(*t, parked, points, sensor_xy, seed, time_s, measurer, &h) || any;
+    any = UpdateHypothesis(*t, parked, points, sensor_xy, seed, time_s, three_d, measurer, &h) ||
+          any;
   }
   return any;
 }
 
 bool TrackManager::UpdateHypothesis(const Track& t, bool parked, const PointSet& points,
                                     const Eigen::Vector2d& sensor_xy, std::uint64_t seed,
-                                    double time_s, TrackMeasurer* measurer, TrackHypothesis* h) {
+                                    double time_s, bool three_d, TrackMeasurer* measurer,
+                                    TrackHypothesis* h) {
   h->updated_this_scan = false;
   const Eigen::Vector3d pose = PoseOf(ekf_.model(h->filter.kind), h->filter.x);
   CentreMeasurement m;
@@ -193,7 +195,7 @@ bool TrackManager::UpdateHypothesis(const Track& t, bool parked, const PointSet&
                         h, &m);
   if (ApplyMeasurement(measured ? &m : nullptr, h) ||
       (measured && RestartLostStill(t, points, m, h))) {
-    ObserveShape(t.small_object, points, time_s, measurer->profile() != nullptr, h);
+    ObserveShape(t.small_object, points, time_s, three_d, h);
   }
   return h->updated_this_scan;
 }

@@ -178,22 +178,24 @@ class TrackManager {
   // A small object whose returns have grown to small_object_grown_extent becomes a rectangle.
   void GrowIntoRectangle(const PointSet& points, const Eigen::Vector2d& sensor_xy,
                          std::uint64_t seed, TrackMeasurer* measurer, Track* t);
-  // Measures and updates every hypothesis; true if any accepted its measurement.
+  // Measures and updates every hypothesis; true if any accepted its measurement. three_d: as for
+  // ObserveShape.
   bool UpdateHypotheses(const PointSet& points, const Eigen::Vector2d& sensor_xy,
-                        std::uint64_t seed, std::int64_t utime, TrackMeasurer* measurer, Track* t);
+                        std::uint64_t seed, std::int64_t utime, bool three_d,
+                        TrackMeasurer* measurer, Track* t);
   bool UpdateHypothesis(const Track& t, bool parked, const PointSet& points,
                         const Eigen::Vector2d& sensor_xy, std::uint64_t seed, double time_s,
-                        TrackMeasurer* measurer, TrackHypothesis* h);
+                        bool three_d, TrackMeasurer* measurer, TrackHypothesis* h);
   // The shape estimate's observations after an accepted update, and on creation. three_d: the
   // returns come from a 3-D scan (a profile was given), whose fits' dimensions are weighted.
   void ObserveShape(bool small, const PointSet& points, double time_s, bool three_d,
                     TrackHypothesis* h) const;
   // The fit's observed length and width (h->fit). On 3-D scans each is weighted by how well its
-  // ends were seen (DimensionSampleWeight, the range noise range_sigma as the best): the long
-  // side of a car seen at a grazing angle from a few returns no longer outweighs dense views of
-  // it, and by the longest-peak rule sets the length. On single-plane scans every one weighs 1:
-  // their vehicle evidence model was fitted to the lengths of unweighted histograms, and weighted,
-  // clutter there grows lengths it calls vehicles (docs/design.md, note 8).
+  // ends were seen (DimensionSampleWeight; a view known to the range noise range_sigma or better
+  // weighs 1): a few returns far apart on the side of a car seen at a grazing angle weigh little
+  // beside dense views of it, and do not set the length by the longest-peak rule. On
+  // single-plane scans every one weighs 1: weighted there, clutter grows lengths that the
+  // single-plane evidence model calls vehicles (docs/design.md, note 8).
   void ObserveFitDimensions(double time_s, bool three_d, TrackHypothesis* h) const;
   // The restart of a lost still object (above); returns whether h was restarted from m.
   bool RestartLostStill(const Track& t, const PointSet& points, const CentreMeasurement& m,

@@ -548,36 +548,44 @@ TEST(ParkedTrackTest, ManagerGivesTheRangeProfileToItsFits) {
   p.extent = 9.0;
   RangeProfile profile;
   profile.Build(Eigen::Vector2d::Zero(), wx, wy, ring, 0.2);
-  for (const RangeProfile* given : std::vector<const RangeProfile*>{nullptr, &profile}) {
-    SCOPED_TRACE(given ? "profile" : "none");
-    const double face_length = given ? 4.5 : 9.0;
-    Scans s;
-    TrackMeasurer worker = s.m.NewMeasurer();  // as a worker thread's, made before any scan
-    p.mean_utime = s.t;
-    ASSERT_TRUE(s.m.Create(p, s.sensor, 1, given));
-    ASSERT_TRUE(s.m.tracks()[0].hyps[0].has_fit);
-    EXPECT_NEAR(s.m.tracks()[0].hyps[0].fit.observed_length_m, face_length, 0.3);
-    // The weight of a sample: 1 on a single-plane scan, else from the fit's uncertainty.
-    auto weight_of = [&](const FitResult& f) {
-      return given ? std::min(1.0, std::pow(s.params.range_sigma / f.observed_length_std_m, 2))
-                   : 1.0;
-    };
-    const double w0 = weight_of(s.m.tracks()[0].hyps[0].fit);
-    const double t0 = static_cast<double>(s.t) * 1e-6;
-    EXPECT_DOUBLE_EQ(s.m.tracks()[0].hyps[0].shape.length_histogram().TotalWeight(t0), w0);
-    if (given) {
-      EXPECT_LT(w0, 0.5);  // ends 0.25 m apart, known to about a spacing
+  // Every pairing of the creation's scan and the update's (3-D or single-plane), so that neither
+  // call can go by what the other was given.
+  for (const RangeProfile* at_create : std::vector<const RangeProfile*>{nullptr, &profile}) {
+    for (const RangeProfile* at_update : std::vector<const RangeProfile*>{nullptr, &profile}) {
+      SCOPED_TRACE(std::string(at_create ? "profile" : "none") + " at creation, " +
+                   (at_update ? "profile" : "none") + " at the update");
+      Scans s;
+      TrackMeasurer worker = s.m.NewMeasurer();  // as a worker thread's, made before any scan
+      // The weight of a sample: 1 on a single-plane scan, else from the fit's uncertainty.
+      auto weight_of = [&](const RangeProfile* given, const FitResult& f) {
+        return given ? std::min(1.0, std::pow(s.params.range_sigma / f.observed_length_std_m, 2))
+                     : 1.0;
+      };
+      p.mean_utime = s.t;
+      ASSERT_TRUE(s.m.Create(p, s.sensor, 1, at_create));
+      ASSERT_TRUE(s.m.tracks()[0].hyps[0].has_fit);
+      EXPECT_NEAR(s.m.tracks()[0].hyps[0].fit.observed_length_m, at_create ? 4.5 : 9.0, 0.3);
+      const double w0 = weight_of(at_create, s.m.tracks()[0].hyps[0].fit);
+      const double t0 = static_cast<double>(s.t) * 1e-6;
+      EXPECT_DOUBLE_EQ(s.m.tracks()[0].hyps[0].shape.length_histogram().TotalWeight(t0), w0);
+      if (at_create) {
+        EXPECT_LT(w0, 0.5);  // ends 0.25 m apart, known to about a spacing
+      }
+      s.m.EndScan(s.t);
+      s.t += kStep;
+      p.mean_utime = s.t;
+      s.m.Update(0, p, s.sensor, 2, nullptr, at_update, &worker);
+      ASSERT_TRUE(s.m.tracks()[0].hyps[0].has_fit);
+      EXPECT_NEAR(s.m.tracks()[0].hyps[0].fit.observed_length_m, at_update ? 4.5 : 9.0, 0.3);
+      const double w1 = weight_of(at_update, s.m.tracks()[0].hyps[0].fit);
+      if (at_update) {
+        EXPECT_LT(w1, 0.5);
+      }
+      const double t1 = static_cast<double>(s.t) * 1e-6;
+      const double decay = std::exp2(-(t1 - t0) / ShapeParams().half_life);
+      EXPECT_NEAR(s.m.tracks()[0].hyps[0].shape.length_histogram().TotalWeight(t1),
+                  w0 * decay + w1, 1e-12);
     }
-    s.m.EndScan(s.t);
-    s.t += kStep;
-    p.mean_utime = s.t;
-    s.m.Update(0, p, s.sensor, 2, nullptr, given, &worker);
-    ASSERT_TRUE(s.m.tracks()[0].hyps[0].has_fit);
-    EXPECT_NEAR(s.m.tracks()[0].hyps[0].fit.observed_length_m, face_length, 0.3);
-    const double t1 = static_cast<double>(s.t) * 1e-6;
-    const double decay = std::exp2(-(t1 - t0) / ShapeParams().half_life);
-    EXPECT_NEAR(s.m.tracks()[0].hyps[0].shape.length_histogram().TotalWeight(t1),
-                w0 * decay + weight_of(s.m.tracks()[0].hyps[0].fit), 1e-12);
   }
 }
 

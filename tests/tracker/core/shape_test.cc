@@ -48,35 +48,49 @@ TEST(Shape, BadSamplesAreRefused) {
   EXPECT_FALSE(hist.Estimate().has_value());
 }
 
-// A sample of weight w counts as w samples of weight 1 taken at the same time: the same total
-// weight, the same estimate, bin for bin (the histogram is linear in its samples).
+// The histogram is linear in its samples' weights: a sample of weight w is w of a sample of
+// weight 1 taken at the same time. At each of six times, 4.5 m with weight 1 and 5.5 m with weight
+// 0.2 against five samples of 4.5 m and one of 5.5 m, each of weight 1: every weight five times
+// as large, the same estimate (4.5 m: the 5.5 m peak is 0.2 of the other's height, below
+// min_peak_fraction 0.25). Unweighted (one sample of each), the longer peak counts and is the
+// estimate.
 TEST(Shape, AWeightedSampleCountsAsThatShareOfOne) {
-  DimensionHistogram weighted, repeated;
+  DimensionHistogram weighted, repeated, plain;
   for (int i = 0; i < 6; ++i) {
-    ASSERT_TRUE(weighted.Add(0.1 * i, 4.5, 0.25));
-    for (int k = 0; k < 4; ++k) ASSERT_TRUE(repeated.Add(0.1 * i, 4.5, 1.0));
+    const double t = 0.1 * i;
+    ASSERT_TRUE(weighted.Add(t, 4.5, 1.0));
+    ASSERT_TRUE(weighted.Add(t, 5.5, 0.2));
+    for (int k = 0; k < 5; ++k) ASSERT_TRUE(repeated.Add(t, 4.5));
+    ASSERT_TRUE(repeated.Add(t, 5.5));
+    ASSERT_TRUE(plain.Add(t, 4.5));
+    ASSERT_TRUE(plain.Add(t, 5.5));
   }
-  // Scaling every weight leaves every ratio the estimate reads (quantile, peak heights).
-  EXPECT_DOUBLE_EQ(weighted.TotalWeight(0.5) * 16.0, repeated.TotalWeight(0.5));
-  ASSERT_TRUE(weighted.Estimate() && repeated.Estimate());
-  EXPECT_DOUBLE_EQ(*weighted.Estimate(), *repeated.Estimate());
-  EXPECT_FALSE(weighted.Add(1.0, 4.5, 0.0));
-  EXPECT_FALSE(weighted.Add(1.0, 4.5, -1.0));
-  EXPECT_FALSE(weighted.Add(1.0, 4.5, std::nan("")));
-  EXPECT_FALSE(weighted.Add(1.0, 4.5, std::numeric_limits<double>::infinity()));
-  EXPECT_DOUBLE_EQ(weighted.TotalWeight(0.5) * 16.0, repeated.TotalWeight(0.5));
+  EXPECT_NEAR(weighted.TotalWeight(0.5) * 5.0, repeated.TotalWeight(0.5), 1e-12);
+  ASSERT_TRUE(weighted.Estimate() && repeated.Estimate() && plain.Estimate());
+  EXPECT_NEAR(*weighted.Estimate(), *repeated.Estimate(), 1e-9);
+  EXPECT_NEAR(*weighted.Estimate(), 4.5, 0.05);
+  EXPECT_NEAR(*plain.Estimate(), 5.5, 0.05);
+  const double before = weighted.TotalWeight(0.5);
+  EXPECT_FALSE(weighted.Add(0.5, 4.5, 0.0));
+  EXPECT_FALSE(weighted.Add(0.5, 4.5, -1.0));
+  EXPECT_FALSE(weighted.Add(0.5, 4.5, std::nan("")));
+  EXPECT_FALSE(weighted.Add(0.5, 4.5, std::numeric_limits<double>::infinity()));
+  EXPECT_EQ(weighted.TotalWeight(0.5), before);
 }
 
 // A car's side seen densely 18 times (4.5 m), and 6 times at a grazing angle from a few returns
 // (6.0 m, each uncertain by 0.3 m where the dense views are by 0.03 m). Unweighted, the longer
 // peak is about a third as high as the other, above min_peak_fraction (0.25), and as the longest
-// counted peak it is the estimate; weighted, (0.03 / 0.3)^2 = 0.01 each, it is no peak.
+// counted peak it is the estimate; weighted, (0.03 / 0.3)^2 = 0.01 each, it holds a third of a
+// percent of the weight: below min_peak_fraction, and inside the excluded top 5 % as well.
 TEST(Shape, SparseViewsWeighedByTheirUncertaintyDoNotSetTheLength) {
   EXPECT_DOUBLE_EQ(DimensionSampleWeight(0.3, 0.03), 0.01);
   EXPECT_DOUBLE_EQ(DimensionSampleWeight(0.03, 0.03), 1.0);
   EXPECT_DOUBLE_EQ(DimensionSampleWeight(0.01, 0.03), 1.0);  // never above one sample
   EXPECT_DOUBLE_EQ(DimensionSampleWeight(std::nan(""), 0.03), 1.0);  // uncertainty not known
   EXPECT_DOUBLE_EQ(DimensionSampleWeight(0.0, 0.03), 1.0);
+  // Nothing known: no weight, and the histogram refuses the sample.
+  EXPECT_EQ(DimensionSampleWeight(std::numeric_limits<double>::infinity(), 0.03), 0.0);
   DimensionHistogram plain, weighted;
   for (int i = 0; i < 24; ++i) {
     const bool grazing = i % 4 == 3;

@@ -589,5 +589,31 @@ TEST(ParkedTrackTest, ManagerGivesTheRangeProfileToItsFits) {
   }
 }
 
+// A corner fit gives a length and a width, each with its own uncertainty; on a 3-D scan each
+// enters its own histogram with the weight of its own uncertainty (the width's face is sampled
+// twice as densely as the side here, so the two differ and an exchange would show).
+TEST(ParkedTrackTest, LengthAndWidthOfACornerAreEachWeighedByTheirOwnUncertainty) {
+  Scans s;
+  PointSet p = ParkedCorner(s.t);
+  std::vector<double> wx, wy;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    wx.push_back(p.origin.x() + p.x[i]);
+    wy.push_back(p.origin.y() + p.y[i]);
+  }
+  RangeProfile profile;
+  profile.Build(s.sensor, wx, wy, 0.2);
+  ASSERT_TRUE(s.m.Create(p, s.sensor, 1, &profile));
+  const TrackHypothesis& h = s.m.tracks()[0].hyps[0];
+  ASSERT_TRUE(h.has_fit);
+  ASSERT_TRUE(std::isfinite(h.fit.observed_length_m) && std::isfinite(h.fit.observed_width_m));
+  const double r = s.params.range_sigma;
+  const double w_len = std::min(1.0, std::pow(r / h.fit.observed_length_std_m, 2));
+  const double w_wid = std::min(1.0, std::pow(r / h.fit.observed_width_std_m, 2));
+  ASSERT_GT(std::abs(w_len - w_wid), 0.01) << w_len << " " << w_wid;
+  const double t = static_cast<double>(s.t) * 1e-6;
+  EXPECT_DOUBLE_EQ(h.shape.length_histogram().TotalWeight(t), w_len);
+  EXPECT_DOUBLE_EQ(h.shape.width_histogram().TotalWeight(t), w_wid);
+}
+
 }  // namespace
 }  // namespace vtrack

@@ -8,6 +8,8 @@
 
 #include <cmath>
 
+#include "tracker/core/double2.h"
+
 namespace vtrack {
 
 // Bound on |Atan2Approx(y, x) - atan2(y, x)| [rad] for finite (x, y) != (0, 0): the series
@@ -16,39 +18,44 @@ namespace vtrack {
 // tests/tracker/core/fast_atan2_test.cc.
 inline constexpr double kAtan2ApproxMaxError = 1e-11;
 
-// atan2(y, x) in [-pi, pi] to within kAtan2ApproxMaxError for finite (x, y) != (0, 0). At
-// (0, 0) it returns 0 and it does not distinguish signed zeros (atan2(+-0, -1) = +-pi, this
-// gives pi for both). Octant reduction to t = min / max in [0, 1], then
-// atan(t) = pi/6 + atan((t - 1/sqrt(3)) / (1 + t/sqrt(3))) for t > tan(pi/12), and the Taylor
-// series of atan on |u| <= tan(pi/12).
-inline double Atan2Approx(double y, double x) {
+// atan2(y, x) in [-pi, pi] to within kAtan2ApproxMaxError for finite (x, y) != (0, 0), two at
+// once (lane by lane; Double2, double2.h). At (0, 0) it returns 0 and it does not distinguish
+// signed zeros (atan2(+-0, -1) = +-pi, this gives pi for both). Octant reduction to t = min / max
+// in [0, 1], then atan(t) = pi/6 + atan((t - 1/sqrt(3)) / (1 + t/sqrt(3))) for t > tan(pi/12),
+// and the Taylor series of atan on |u| <= tan(pi/12). Without branches (both reductions are
+// computed and one is selected), so that a loop over returns runs two per step; each lane is
+// exactly the value the same steps give one at a time.
+inline Double2 Atan2Approx2(Double2 y, Double2 x) {
   constexpr double kPi = 3.14159265358979323846;
   constexpr double kTanPi12 = 0.26794919243112270;  // tan(pi/12) = 2 - sqrt(3)
   constexpr double kInvSqrt3 = 0.57735026918962576;
-  const double ax = std::abs(x), ay = std::abs(y);
-  const double hi = ax > ay ? ax : ay, lo = ax > ay ? ay : ax;
-  if (!(hi > 0.0)) return 0.0;
-  double t = lo / hi;
-  double base = 0.0;
-  if (t > kTanPi12) {
-    t = (t - kInvSqrt3) / (1.0 + t * kInvSqrt3);
-    base = kPi / 6.0;
-  }
-  const double u2 = t * t;
+  const Double2 ax = Abs2(x), ay = Abs2(y);
+  const Mask2 x_wide = ax > ay;
+  const Double2 hi = x_wide ? ax : ay, lo = x_wide ? ay : ax;
+  const Double2 t0 = lo / hi;  // NaN at (0, 0): that lane is 0 at the end
+  const Mask2 reduce = t0 > Splat(kTanPi12);
+  const Double2 t1 = (t0 - Splat(kInvSqrt3)) / (Splat(1.0) + t0 * Splat(kInvSqrt3));
+  const Double2 t = reduce ? t1 : t0;
+  const Double2 base = reduce ? Splat(kPi / 6.0) : Splat(0.0);
+  const Double2 u2 = t * t;
   // u - u^3/3 + u^5/5 - ... + u^17/17 (Horner in u^2).
-  double s = 1.0 / 17.0;
-  s = 1.0 / 15.0 - u2 * s;
-  s = 1.0 / 13.0 - u2 * s;
-  s = 1.0 / 11.0 - u2 * s;
-  s = 1.0 / 9.0 - u2 * s;
-  s = 1.0 / 7.0 - u2 * s;
-  s = 1.0 / 5.0 - u2 * s;
-  s = 1.0 / 3.0 - u2 * s;
-  s = 1.0 - u2 * s;
-  double a = base + t * s;
-  if (ay > ax) a = 0.5 * kPi - a;
-  if (x < 0.0) a = kPi - a;
-  return y < 0.0 ? -a : a;
+  Double2 s = Splat(1.0 / 17.0);
+  s = Splat(1.0 / 15.0) - u2 * s;
+  s = Splat(1.0 / 13.0) - u2 * s;
+  s = Splat(1.0 / 11.0) - u2 * s;
+  s = Splat(1.0 / 9.0) - u2 * s;
+  s = Splat(1.0 / 7.0) - u2 * s;
+  s = Splat(1.0 / 5.0) - u2 * s;
+  s = Splat(1.0 / 3.0) - u2 * s;
+  s = Splat(1.0) - u2 * s;
+  Double2 a = base + t * s;
+  a = ay > ax ? Splat(0.5 * kPi) - a : a;
+  a = x < Splat(0.0) ? Splat(kPi) - a : a;
+  a = y < Splat(0.0) ? -a : a;
+  return hi > Splat(0.0) ? a : Splat(0.0);
 }
+
+// One at a time: the first lane of Atan2Approx2.
+inline double Atan2Approx(double y, double x) { return Atan2Approx2(Splat(y), Splat(x))[0]; }
 
 }  // namespace vtrack

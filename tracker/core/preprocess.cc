@@ -221,8 +221,8 @@ struct ReturnFilter {
 
 void Preprocessor::Compensate(const LadarScan& scan, PreprocessStats* stats, WorldPoints* out) {
   const std::size_t n = scan.size();
-  // Written by index into arrays sized for every return, trimmed at the end (no push_back). Not
-  // cleared first: resize() then value-initialises only what the previous scan did not use.
+  // Written by index into arrays sized for every return, trimmed at the end (no push_back); their
+  // resize() writes nothing (ReturnArray), each element is written below before it is read.
   out->x.resize(n);
   out->y.resize(n);
   out->height.resize(n);
@@ -275,6 +275,7 @@ void Preprocessor::PlaceReturns(const LadarScan& scan, std::size_t begin, std::s
   const std::int64_t last_interval = static_cast<std::int64_t>(knots_.size()) - 1;
   // Body-frame height of a return: the z row of body_from_sensor (the mounting is rigid).
   const Eigen::Vector4f body_z = scan.body_from_sensor.matrix().row(2).transpose().cast<float>();
+  const float bz0 = body_z(0), bz1 = body_z(1), bz2 = body_z(2), bz3 = body_z(3);
   // dt / step without a 64-bit division per return: a floating-point guess, corrected to the
   // exact quotient.
   const double inv_step = 1.0 / static_cast<double>(step);
@@ -293,29 +294,73 @@ void Preprocessor::PlaceReturns(const LadarScan& scan, std::size_t begin, std::s
   const std::int32_t* const dts = scan.dt_us.size() == scan.size() ? scan.dt_us.data() : nullptr;
   const std::uint8_t* const refusal = refusal_.data();
   std::size_t w = first_out;
-  for (std::size_t i = begin; i < end; ++i) {
+  std::size_t i = begin;
+  while (i < end) {
     if (refusal[i] != ReturnFilter::kKept) {
       ++refused[refusal[i]];
+      ++i;
       continue;
     }
+    // The knot interval of return i, and the run of kept returns from i on in the same interval
+    // (a sensor measures in time order, so runs are long: ~40 returns of a 64-beam sweep per 1 ms
+    // interval, ring by ring).
     const std::int64_t dt = dts != nullptr ? dts[i] : 0;
     std::int64_t q = static_cast<std::int64_t>(static_cast<double>(dt) * inv_step);
     if (q * step > dt) --q;
     if ((q + 1) * step <= dt) ++q;
     const std::int64_t k = std::min(q, last_interval);
+    const std::int64_t lo = k * step;
+    // The last interval takes every later time (q beyond it: the sweep's end).
+    const std::int64_t hi = k == last_interval ? std::numeric_limits<std::int64_t>::max() : lo + step;
+    std::size_t run_end = i + 1;
+    if (dts != nullptr) {
+      while (run_end < end && refusal[run_end] == ReturnFilter::kKept && dts[run_end] >= lo &&
+             dts[run_end] < hi) {
+        ++run_end;
+      }
+    } else {
+      while (run_end < end && refusal[run_end] == ReturnFilter::kKept) ++run_end;
+    }
+    // The run: the same operations as for one return at a time, lane by lane (rows x and y of
+    // the rotation and their rates; the translation in double), which the compiler vectorises.
     const Knot& knot = knots[k];
-    const float u = static_cast<float>(dt - k * step);  // [us] into the interval
-    const float px = sx[i], py = sy[i], pz = sz[i];
-    // 4-lane products, a column at a time: the rotation's rows and their rates applied at once.
-    const Eigen::Vector4f r =
-        knot.rotation.col(0) * px + knot.rotation.col(1) * py + knot.rotation.col(2) * pz;
-    const Eigen::Vector2d t = knot.translation + static_cast<double>(u) * knot.translation_rate;
-    ox[w] = t.x() + static_cast<double>(r(0) + u * r(2));
-    oy[w] = t.y() + static_cast<double>(r(1) + u * r(3));
-    oh[w] = body_z(0) * px + body_z(1) * py + body_z(2) * pz + body_z(3);
-    oi[w] = static_cast<std::int32_t>(i);
-    orng[w] = sring != nullptr ? sring[i] : std::int16_t{0};
-    ++w;
+    const float r00 = knot.rotation(0, 0), r01 = knot.rotation(0, 1), r02 = knot.rotation(0, 2);
+    const float r10 = knot.rotation(1, 0), r11 = knot.rotation(1, 1), r12 = knot.rotation(1, 2);
+    const float d00 = knot.rotation(2, 0), d01 = knot.rotation(2, 1), d02 = knot.rotation(2, 2);
+    const float d10 = knot.rotation(3, 0), d11 = knot.rotation(3, 1), d12 = knot.rotation(3, 2);
+    const double tx = knot.translation.x(), ty = knot.translation.y();
+    const double vx = knot.translation_rate.x(), vy = knot.translation_rate.y();
+    const std::size_t n = run_end - i;
+    const float* __restrict const px = sx + i;
+    const float* __restrict const py = sy + i;
+    const float* __restrict const pz = sz + i;
+    double* __restrict const wx = ox + w;
+    double* __restrict const wy = oy + w;
+    float* __restrict const wh = oh + w;
+    const auto place = [&](std::size_t m, float u) {
+      const float x = px[m], y = py[m], z = pz[m];
+      const float a = r00 * x + r01 * y + r02 * z;
+      const float b = r10 * x + r11 * y + r12 * z;
+      const float da = d00 * x + d01 * y + d02 * z;
+      const float db = d10 * x + d11 * y + d12 * z;
+      const double ud = static_cast<double>(u);
+      wx[m] = (tx + ud * vx) + static_cast<double>(a + u * da);
+      wy[m] = (ty + ud * vy) + static_cast<double>(b + u * db);
+      wh[m] = bz0 * x + bz1 * y + bz2 * z + bz3;
+    };
+    if (dts != nullptr) {
+      const std::int32_t* __restrict const dt_run = dts + i;
+      const std::int32_t lo32 = static_cast<std::int32_t>(lo);
+      for (std::size_t m = 0; m < n; ++m) place(m, static_cast<float>(dt_run[m] - lo32));
+    } else {
+      for (std::size_t m = 0; m < n; ++m) place(m, 0.0f);
+    }
+    for (std::size_t m = 0; m < n; ++m) {
+      oi[w + m] = static_cast<std::int32_t>(i + m);
+      orng[w + m] = sring != nullptr ? sring[i + m] : std::int16_t{0};
+    }
+    w += n;
+    i = run_end;
   }
 }
 
@@ -477,18 +522,29 @@ void Preprocessor::BinLowestReturns(const GroundGrid& grid, const WorldPoints& p
   int cell_exp = 0;
   const bool exact_inverse = std::frexp(cell, &cell_exp) == 0.5;
   const double inv_cell = 1.0 / cell;
-  const auto cell_index = [&](double offset) {
-    const double c = exact_inverse ? offset * inv_cell : offset / cell;
-    return c >= 1.0 && c <= side - 2.0 ? static_cast<int>(c) : (c > side - 2.0 ? side - 2 : 1);
+  const double last = side - 2.0;
+  // Without branches (selects that give the same cell: below 1, or NaN, to 1; beyond the last to
+  // it), so that the compiler vectorises the loop; then each return's cell lowered, in order.
+  const auto cell_of = [last](double c) {
+    c = c > last ? last : c;
+    return static_cast<std::int32_t>(c >= 1.0 ? c : 1.0);
   };
+  const double x0 = grid.x0, y0 = grid.y0;
   const auto bin = [&](std::size_t begin, std::size_t end, float* lowest) {
-    for (std::size_t i = begin; i < end; ++i) {
-      const int cx = cell_index(px[i] - grid.x0);
-      const int cy = cell_index(py[i] - grid.y0);
-      const std::int32_t c = cy * side + cx;
-      pc[i] = c;
-      lowest[c] = std::min(lowest[c], ph[i]);
+    std::int32_t* __restrict const cells = pc + begin;
+    const double* __restrict const xs = px + begin;
+    const double* __restrict const ys = py + begin;
+    const std::size_t n_run = end - begin;
+    if (exact_inverse) {
+      for (std::size_t k = 0; k < n_run; ++k) {
+        cells[k] = cell_of((ys[k] - y0) * inv_cell) * side + cell_of((xs[k] - x0) * inv_cell);
+      }
+    } else {
+      for (std::size_t k = 0; k < n_run; ++k) {
+        cells[k] = cell_of((ys[k] - y0) / cell) * side + cell_of((xs[k] - x0) / cell);
+      }
     }
+    for (std::size_t i = begin; i < end; ++i) lowest[pc[i]] = std::min(lowest[pc[i]], ph[i]);
   };
   // In chunks, one per thread, each with a grid of its own (the first: cell_min_), then the
   // lowest of each cell over the grids: a minimum, the same in any order. Only while a grid is

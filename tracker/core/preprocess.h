@@ -31,7 +31,10 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <memory>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "base/pose.h"
@@ -41,17 +44,43 @@
 
 namespace vtrack {
 
+// std::allocator, but a resize() that grows leaves the new elements uninitialised (default-
+// initialised) instead of zeroing them: the returns' arrays are sized for every return of a sweep,
+// filled by index and trimmed to the returns kept, so each sweep would otherwise zero again what
+// the last one trimmed off (2 MB of a 64-beam sweep, every element then overwritten).
+template <class T>
+struct UninitialisedAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = UninitialisedAllocator<U>;
+  };
+  UninitialisedAllocator() = default;
+  template <class U>
+  UninitialisedAllocator(const UninitialisedAllocator<U>&) noexcept {}
+  template <class U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+// An array of one value per return (WorldPoints).
+template <class T>
+using ReturnArray = std::vector<T, UninitialisedAllocator<T>>;
+
 // Returns kept after preprocessing, world frame, structure of arrays.
 struct WorldPoints {
-  std::vector<double> x, y;            // [m] world frame
-  std::vector<float> height;           // [m] above the local ground (body z for 2-D scans)
-  std::vector<std::int32_t> index;     // [-] index of the return in the scan
-  std::vector<std::int16_t> ring;      // [-]
+  ReturnArray<double> x, y;            // [m] world frame
+  ReturnArray<float> height;           // [m] above the local ground (body z for 2-D scans)
+  ReturnArray<std::int32_t> index;     // [-] index of the return in the scan
+  ReturnArray<std::int16_t> ring;      // [-]
   // [m] 3-D clouds, grid ground only (else empty): the height above the local ground of the
   // highest return in the return's ground cell, those above max_height included (a car's roof,
   // a van's, a truck's, a tree crown, a building front). A vehicle-evidence feature
   // (vehicle_evidence.h).
-  std::vector<float> column_top;
+  ReturnArray<float> column_top;
 
   std::size_t size() const { return x.size(); }
   void clear();

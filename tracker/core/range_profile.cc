@@ -27,13 +27,13 @@ double MedianBearingStepDeg(const std::vector<float>& x, const std::vector<float
   return RadToDeg(*mid);
 }
 
-void RangeProfile::Build(const Eigen::Vector2d& sensor_xy, const std::vector<double>& x,
-                         const std::vector<double>& y, double bin_deg) {
+void RangeProfile::Build(const Eigen::Vector2d& sensor_xy, std::span<const double> x,
+                         std::span<const double> y, double bin_deg) {
   Build(sensor_xy, x, y, {}, bin_deg);
 }
 
-void RangeProfile::Build(const Eigen::Vector2d& sensor_xy, const std::vector<double>& x,
-                         const std::vector<double>& y, const std::vector<std::int16_t>& ring,
+void RangeProfile::Build(const Eigen::Vector2d& sensor_xy, std::span<const double> x,
+                         std::span<const double> y, std::span<const std::int16_t> ring,
                          double bin_deg) {
   sensor_ = sensor_xy;
   num_bins_ = std::max(1, static_cast<int>(std::ceil(360.0 / bin_deg)));
@@ -53,10 +53,7 @@ void RangeProfile::Build(const Eigen::Vector2d& sensor_xy, const std::vector<dou
   // rounding of the sum and product) cannot change the floor; else Bin() itself. Same bins.
   const int n = num_bins_;
   const double slack = 10.0 * kAtan2ApproxMaxError * inv_bin_ + 1e-9;
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    const Eigen::Vector2d p(x[i], y[i]);
-    const Eigen::Vector2d d = p - sensor_;
-    const double v = (Atan2Approx(d.y(), d.x()) + kPi) * inv_bin_;
+  const auto keep = [&](std::size_t i, double v, double range) {
     // v is in [-slack, n + slack]: the cast is floor(v) for v >= 0, and v - b is exact. The
     // interval v +- slack inside one bin: that bin (n wraps to 0 as in Bin(), without its two
     // divisions); else Bin() itself (v < 0 included).
@@ -65,11 +62,28 @@ void RangeProfile::Build(const Eigen::Vector2d& sensor_xy, const std::vector<dou
     if (frac >= slack && frac < 1.0 - slack) {
       if (b >= n) b -= n;
     } else {
-      b = Bin(p);
+      b = Bin(Eigen::Vector2d(x[i], y[i]));
     }
     float& r = nearest_[static_cast<std::size_t>(ring_of(i)) * static_cast<std::size_t>(n) +
                         static_cast<std::size_t>(b)];
-    r = std::min(r, static_cast<float>(d.norm()));
+    r = std::min(r, static_cast<float>(range));
+  };
+  // Two returns per step: the bearing and range of each lane are the doubles one return at a
+  // time would give (p - sensor, Atan2Approx, the norm).
+  const Double2 sx = Splat(sensor_.x()), sy = Splat(sensor_.y());
+  const Double2 shift = Splat(kPi), scale = Splat(inv_bin_);
+  const std::size_t size = x.size();
+  std::size_t i = 0;
+  for (; i + 1 < size; i += 2) {
+    const Double2 dx = Load2(x.data() + i) - sx, dy = Load2(y.data() + i) - sy;
+    const Double2 v = (Atan2Approx2(dy, dx) + shift) * scale;
+    const Double2 r2 = dx * dx + dy * dy;
+    keep(i, v[0], std::sqrt(r2[0]));
+    keep(i + 1, v[1], std::sqrt(r2[1]));
+  }
+  if (i < size) {
+    const Eigen::Vector2d d = Eigen::Vector2d(x[i], y[i]) - sensor_;
+    keep(i, (Atan2Approx(d.y(), d.x()) + kPi) * inv_bin_, d.norm());
   }
 }
 

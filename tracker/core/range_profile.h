@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace vtrack {
@@ -34,11 +35,11 @@ double MedianBearingStepDeg(const std::vector<float>& x, const std::vector<float
 class RangeProfile {
  public:
   // bin_deg: bearing bin [deg], > 0. One profile over all returns (a single-plane scanner).
-  void Build(const Eigen::Vector2d& sensor_xy, const std::vector<double>& x,
-             const std::vector<double>& y, double bin_deg);
+  void Build(const Eigen::Vector2d& sensor_xy, std::span<const double> x,
+             std::span<const double> y, double bin_deg);
   // One profile per ring (ring[i] of return i; rings outside [0, kMaxRings) share the last).
-  void Build(const Eigen::Vector2d& sensor_xy, const std::vector<double>& x,
-             const std::vector<double>& y, const std::vector<std::int16_t>& ring, double bin_deg);
+  void Build(const Eigen::Vector2d& sensor_xy, std::span<const double> x,
+             std::span<const double> y, std::span<const std::int16_t> ring, double bin_deg);
   // True if, in the `bins` bearing bins just beyond `end` (on the side away from `inner`, the
   // face's other end), no return lies nearer than end's range + margin, on the rings that see
   // the face at its end (a return within margin of end's range in end's bin or the one inside

@@ -200,71 +200,130 @@ TEST(PreprocessTest, EachRefusedReturnIsCountedOnceByItsFirstReason) {
   EXPECT_EQ(st.kept, 0);
 }
 
-// The single-precision compensation against the same knot interpolation in double, computed
-// here from the pose history: every return within kCompensationTolerance of its range, with the
-// ego 3 km from the world origin (a world-scale translation in single precision would miss that
-// by 1e-4 m and more) turning at 1 rad/s, returns out to 120 m in every direction. Two sweeps:
-// one whose last knot interval is shorter than knot_us, one that knot_us divides (a return at
-// its very end lies on the last knot).
-TEST(PreprocessTest, SinglePrecisionCompensationStaysWithinItsToleranceOfDouble) {
+// The largest distance [m per m of range] of the returns in `out` (plane, and height) from the
+// same knot interpolation in double, computed here from the pose history.
+std::pair<double, double> WorstAgainstDouble(const LadarScan& scan, const PoseHistory& poses,
+                                             const PreprocessParams& params,
+                                             const WorldPoints& out) {
+  const std::int64_t step = params.knot_us;
+  const std::int64_t sweep = scan.sweep_duration_us;
+  auto world_from_sensor = [&](std::int64_t dt) {
+    return (*poses.At(scan.utime + dt, 0) * scan.body_from_sensor).matrix();
+  };
+  double worst = 0.0, worst_height = 0.0;
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    const auto i = static_cast<std::size_t>(out.index[k]);
+    const Eigen::Vector4d p(scan.x[i], scan.y[i], scan.z[i], 1.0);
+    const std::int64_t dt = scan.dt_us[i];
+    const std::int64_t t0 = std::min<std::int64_t>(dt / step, (sweep - 1) / step) * step;
+    const std::int64_t t1 = std::min<std::int64_t>(t0 + step, sweep);
+    const double f = static_cast<double>(dt - t0) / static_cast<double>(t1 - t0);
+    const Eigen::Matrix4d m0 = world_from_sensor(t0);
+    const Eigen::Vector4d ref = (m0 + f * (world_from_sensor(t1) - m0)) * p;
+    const double range = p.head<3>().norm();
+    worst = std::max(worst, std::hypot(out.x[k] - ref.x(), out.y[k] - ref.y()) / range);
+    const double height = (scan.body_from_sensor * p.head<3>()).z();
+    worst_height = std::max(worst_height, std::abs(out.height[k] - height) / range);
+  }
+  return {worst, worst_height};
+}
+
+// The ego 3 km from the world origin (a world-scale translation in single precision would miss
+// that by 1e-4 m and more) turning at 1 rad/s.
+PoseHistory FarTurningPoses() {
   const double v = 15.0, w = 1.0;
   PoseHistory poses(10'000'000);
   const Eigen::Translation3d far_away(3000.0, -2500.0, 40.0);
   for (std::int64_t t = -50'000; t <= 300'000; t += 10'000) {
     poses.Add(kT0 + t, far_away * EgoAt(t * 1e-6, v, w));
   }
+  return poses;
+}
+
+// A sweep of `count` returns out to 120 m in every direction, timed by dt_of(i).
+template <class DtOf>
+LadarScan RandomSweep(std::int32_t sweep, int count, std::uint32_t seed, DtOf dt_of) {
+  LadarScan scan;
+  scan.utime = kT0 + 50'000;
+  scan.sweep_duration_us = sweep;
+  scan.num_rings = 1;
+  scan.body_from_sensor.translation() = Eigen::Vector3d(1.2, 0.3, 1.8);
+  scan.body_from_sensor.linear() = QuaternionFromRpy(0.02, 0.05, 0.3).toRotationMatrix();
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> ang(-kPi, kPi), elev(-0.4, 0.2), rr(1.5, 120.0);
+  for (int i = 0; i < count; ++i) {
+    const double a = ang(rng), e = elev(rng), r = rr(rng);
+    scan.x.push_back(static_cast<float>(r * std::cos(e) * std::cos(a)));
+    scan.y.push_back(static_cast<float>(r * std::cos(e) * std::sin(a)));
+    scan.z.push_back(static_cast<float>(r * std::sin(e)));
+    scan.intensity.push_back(0.0f);
+    scan.dt_us.push_back(dt_of(i, rng));
+    scan.ring.push_back(0);
+  }
+  return scan;
+}
+
+// The single-precision compensation against the same knot interpolation in double: every return
+// within kCompensationTolerance of its range. Two sweeps: one whose last knot interval is
+// shorter than knot_us, one that knot_us divides (a return at its very end lies on the last
+// knot).
+TEST(PreprocessTest, SinglePrecisionCompensationStaysWithinItsToleranceOfDouble) {
+  const PoseHistory poses = FarTurningPoses();
   for (const std::int32_t sweep : {99'500, 100'000}) {
-    LadarScan scan;
-    scan.utime = kT0 + 50'000;
-    scan.sweep_duration_us = sweep;
-    scan.num_rings = 1;
-    scan.body_from_sensor.translation() = Eigen::Vector3d(1.2, 0.3, 1.8);
-    scan.body_from_sensor.linear() = QuaternionFromRpy(0.02, 0.05, 0.3).toRotationMatrix();
-    std::mt19937 rng(11);
-    std::uniform_real_distribution<double> ang(-kPi, kPi), elev(-0.4, 0.2), rr(1.5, 120.0);
     std::uniform_int_distribution<std::int32_t> dtd(0, sweep);
-    for (int i = 0; i < 20000; ++i) {
-      const double a = ang(rng), e = elev(rng), r = rr(rng);
-      scan.x.push_back(static_cast<float>(r * std::cos(e) * std::cos(a)));
-      scan.y.push_back(static_cast<float>(r * std::cos(e) * std::sin(a)));
-      scan.z.push_back(static_cast<float>(r * std::sin(e)));
-      scan.intensity.push_back(0.0f);
-      // Every tenth return exactly on a knot (the end of one interval, the start of the next),
-      // every hundredth at the sweep's end.
+    // Every tenth return exactly on a knot (the end of one interval, the start of the next),
+    // every hundredth at the sweep's end; the others at random times, in no order.
+    const LadarScan scan = RandomSweep(sweep, 20000, 11, [&](int i, std::mt19937& rng) {
       const std::int32_t dt = dtd(rng);
-      scan.dt_us.push_back(i % 100 == 0 ? sweep : i % 10 == 0 ? dt / 1000 * 1000 : dt);
-      scan.ring.push_back(0);
-    }
+      return i % 100 == 0 ? sweep : i % 10 == 0 ? dt / 1000 * 1000 : dt;
+    });
     PreprocessParams params;
     params.max_range = 130.0;
     Preprocessor pre(params);
     WorldPoints out;
     ASSERT_EQ(pre.Run(scan, poses, 0, &out).status, CompensationStatus::kOk);
     ASSERT_EQ(out.size(), scan.size());
-    const std::int64_t step = params.knot_us;
-    auto world_from_sensor = [&](std::int64_t dt) {
-      return (*poses.At(scan.utime + dt, 0) * scan.body_from_sensor).matrix();
-    };
-    double worst = 0.0, worst_height = 0.0;  // [m per m of range]
-    for (std::size_t k = 0; k < out.size(); ++k) {
-      const auto i = static_cast<std::size_t>(out.index[k]);
-      const Eigen::Vector4d p(scan.x[i], scan.y[i], scan.z[i], 1.0);
-      const std::int64_t dt = scan.dt_us[i];
-      const std::int64_t t0 = std::min<std::int64_t>(dt / step, (sweep - 1) / step) * step;
-      const std::int64_t t1 = std::min<std::int64_t>(t0 + step, sweep);
-      const double f = static_cast<double>(dt - t0) / static_cast<double>(t1 - t0);
-      const Eigen::Matrix4d m0 = world_from_sensor(t0);
-      const Eigen::Vector4d ref = (m0 + f * (world_from_sensor(t1) - m0)) * p;
-      const double range = p.head<3>().norm();
-      worst = std::max(worst, std::hypot(out.x[k] - ref.x(), out.y[k] - ref.y()) / range);
-      const double height = (scan.body_from_sensor * p.head<3>()).z();
-      worst_height = std::max(worst_height, std::abs(out.height[k] - height) / range);
-    }
+    const auto [worst, worst_height] = WorstAgainstDouble(scan, poses, params, out);
     std::printf("sweep %d us: largest distance from the double-precision interpolation: %.2e m "
                 "per m of range (plane), %.2e (height)\n", sweep, worst, worst_height);
     EXPECT_LE(worst, kCompensationTolerance) << "sweep " << sweep;
     EXPECT_LE(worst_height, kCompensationTolerance) << "sweep " << sweep;
   }
+}
+
+// Returns in time order, as a sensor gives them, are placed a run of one knot interval at a time:
+// runs that end at a knot, at a refused return (every 37th nearer than min_range, every 53rd
+// timed after the sweep) and at the sweep's end must each take their own interval's pose.
+TEST(PreprocessTest, ReturnsInTimeOrderArePlacedByTheirOwnKnotInterval) {
+  const PoseHistory poses = FarTurningPoses();
+  const std::int32_t sweep = 99'500;
+  LadarScan scan = RandomSweep(sweep, 20000, 12, [&](int i, std::mt19937&) {
+    return static_cast<std::int32_t>(static_cast<std::int64_t>(i) * sweep / 19999);
+  });
+  std::int64_t near = 0, late = 0;
+  for (std::size_t i = 0; i < scan.size(); ++i) {
+    if (i % 37 == 5) {
+      scan.x[i] = 0.1f, scan.y[i] = 0.0f, scan.z[i] = 0.0f;
+      ++near;
+    } else if (i % 53 == 7) {
+      scan.dt_us[i] = sweep + 1;
+      ++late;
+    }
+  }
+  PreprocessParams params;
+  params.max_range = 130.0;
+  Preprocessor pre(params);
+  WorldPoints out;
+  const PreprocessResult res = pre.Run(scan, poses, 0, &out);
+  ASSERT_EQ(res.status, CompensationStatus::kOk);
+  EXPECT_EQ(res.stats.out_of_range, near);
+  EXPECT_EQ(res.stats.bad_time, late);
+  ASSERT_EQ(static_cast<std::int64_t>(out.size()), static_cast<std::int64_t>(scan.size()) - near - late);
+  // In order, each kept return once.
+  for (std::size_t k = 1; k < out.size(); ++k) ASSERT_LT(out.index[k - 1], out.index[k]);
+  const auto [worst, worst_height] = WorstAgainstDouble(scan, poses, params, out);
+  EXPECT_LE(worst, kCompensationTolerance);
+  EXPECT_LE(worst_height, kCompensationTolerance);
 }
 
 TEST(PreprocessTest, AnyNumberOfThreadsPlacesAndKeepsTheSameReturns) {

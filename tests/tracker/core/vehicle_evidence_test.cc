@@ -213,7 +213,7 @@ TEST(VehicleEvidence, ReturnsGiveTheirHeightProfileColumnTopRangeAndSegmentExten
   const ReturnEvidence r =
       MeasureReturns(pts, idx, segment_of, extent, Eigen::Vector2d(2.0, 5.0), true, 3, nullptr, &scratch);
 
-  std::vector<float> sorted = pts.height;
+  std::vector<float> sorted(pts.height.begin(), pts.height.end());
   std::sort(sorted.begin(), sorted.end());
   double cx = 0, cy = 0;
   for (std::size_t i = 0; i < 101; ++i) {

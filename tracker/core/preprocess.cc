@@ -72,11 +72,14 @@ PreprocessResult Preprocessor::Run(const LadarScan& scan, const PoseHistory& pos
     out->clear();
     return result;
   }
-  Compensate(scan, &result.stats, out);
-  // Ground: a grid of local ground heights (3-D clouds), or a fixed band.
+  // Ground: a grid of local ground heights (3-D clouds; the returns binned in it as they are
+  // placed), or a fixed band.
   const bool cloud_3d = scan.num_rings >= params_.ground_min_rings;
-  if (cloud_3d && params_.ground == PreprocessParams::Ground::kGrid) {
-    RemoveGround(result.sensor_xy, out, &result.stats);
+  const bool grid_ground = cloud_3d && params_.ground == PreprocessParams::Ground::kGrid;
+  const GroundGrid grid = MakeGroundGrid(result.sensor_xy);
+  Compensate(scan, grid_ground ? &grid : nullptr, &result.stats, out);
+  if (grid_ground) {
+    RemoveGround(grid, out, &result.stats);
   } else if (cloud_3d && params_.ground == PreprocessParams::Ground::kBand) {
     RemoveGroundBand(out, &result.stats);
   }
@@ -219,7 +222,8 @@ struct ReturnFilter {
 
 }  // namespace
 
-void Preprocessor::Compensate(const LadarScan& scan, PreprocessStats* stats, WorldPoints* out) {
+void Preprocessor::Compensate(const LadarScan& scan, const GroundGrid* grid,
+                              PreprocessStats* stats, WorldPoints* out) {
   const std::size_t n = scan.size();
   // Written by index into arrays sized for every return, trimmed at the end (no push_back); their
   // resize() writes nothing (ReturnArray), each element is written below before it is read.
@@ -242,18 +246,42 @@ void Preprocessor::Compensate(const LadarScan& scan, PreprocessStats* stats, Wor
                                             refusal_.begin() + static_cast<std::ptrdiff_t>(ChunkBegin(n, c + 1, chunks)),
                                             std::uint8_t{ReturnFilter::kKept}));
   }
+  // Binned in the ground grid as they are placed: each chunk lowers a grid of its own (the
+  // first: cell_min_), then each cell takes the lowest over the grids (a minimum: the same in
+  // any order).
+  const std::size_t num_cells = grid != nullptr ? static_cast<std::size_t>(grid->side) * grid->side : 0;
+  if (grid != nullptr) {
+    cell_min_.assign(num_cells, std::numeric_limits<float>::infinity());
+    point_cell_.resize(n);
+    worker_cell_min_.resize(static_cast<std::size_t>(chunks) - 1);
+  }
   std::vector<std::array<std::int64_t, ReturnFilter::kNumRefusals>> refused_by_chunk(
       static_cast<std::size_t>(chunks));
   const auto place = [&](std::size_t c, int) {
     refused_by_chunk[c].fill(0);
+    float* lowest = nullptr;
+    if (grid != nullptr) {
+      lowest = cell_min_.data();
+      if (c > 0) {
+        std::vector<float>& own = worker_cell_min_[c - 1];
+        own.assign(num_cells, std::numeric_limits<float>::infinity());
+        lowest = own.data();
+      }
+    }
     PlaceReturns(scan, ChunkBegin(n, static_cast<int>(c), chunks),
-                 ChunkBegin(n, static_cast<int>(c) + 1, chunks), first_out[c], out,
-                 refused_by_chunk[c].data());
+                 ChunkBegin(n, static_cast<int>(c) + 1, chunks), first_out[c], grid,
+                 point_cell_.data(), lowest, out, refused_by_chunk[c].data());
   };
   if (chunks == 1) {
     place(0, 0);
   } else {
     pool_->ParallelFor(static_cast<std::size_t>(chunks), place);
+  }
+  if (grid != nullptr) {
+    float* const cmin = cell_min_.data();
+    for (const std::vector<float>& own : worker_cell_min_) {
+      for (std::size_t c = 0; c < num_cells; ++c) cmin[c] = std::min(cmin[c], own[c]);
+    }
   }
   std::int64_t refused[ReturnFilter::kNumRefusals] = {};
   for (const auto& chunk : refused_by_chunk) {
@@ -269,7 +297,8 @@ void Preprocessor::Compensate(const LadarScan& scan, PreprocessStats* stats, Wor
 }
 
 void Preprocessor::PlaceReturns(const LadarScan& scan, std::size_t begin, std::size_t end,
-                                std::size_t first_out, WorldPoints* out,
+                                std::size_t first_out, const GroundGrid* grid,
+                                std::int32_t* cells, float* lowest, WorldPoints* out,
                                 std::int64_t* refused) const {
   const std::int64_t step = params_.knot_us;
   const std::int64_t last_interval = static_cast<std::int64_t>(knots_.size()) - 1;
@@ -359,6 +388,9 @@ void Preprocessor::PlaceReturns(const LadarScan& scan, std::size_t begin, std::s
       oi[w + m] = static_cast<std::int32_t>(i + m);
       orng[w + m] = sring != nullptr ? sring[i + m] : std::int16_t{0};
     }
+    // Binned while the run is at hand (a pass of its own over the placed returns read them back
+    // from memory).
+    if (grid != nullptr) grid->Bin(wx, wy, wh, n, cells + w, lowest);
     w += n;
     i = run_end;
   }
@@ -440,14 +472,17 @@ void Preprocessor::RemoveGroundBand(WorldPoints* out, PreprocessStats* stats) co
   stats->ground = static_cast<std::int64_t>(n - JoinKeptRanges({0}, {kept}, out, nullptr));
 }
 
-void Preprocessor::RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts,
-                                PreprocessStats* stats) {
-  const double cell = params_.ground_cell;
+Preprocessor::GroundGrid Preprocessor::MakeGroundGrid(const Eigen::Vector2d& center) const {
   GroundGrid grid;
-  grid.side = static_cast<int>(std::ceil(2.0 * params_.max_range / cell)) + 3;
-  grid.x0 = center.x() - 0.5 * grid.side * cell;
-  grid.y0 = center.y() - 0.5 * grid.side * cell;
-  BinLowestReturns(grid, *pts);
+  grid.cell = params_.ground_cell;
+  grid.side = static_cast<int>(std::ceil(2.0 * params_.max_range / grid.cell)) + 3;
+  grid.x0 = center.x() - 0.5 * grid.side * grid.cell;
+  grid.y0 = center.y() - 0.5 * grid.side * grid.cell;
+  return grid;
+}
+
+void Preprocessor::RemoveGround(const GroundGrid& grid, WorldPoints* pts,
+                                PreprocessStats* stats) {
   BoundByGrade(grid);
   const float level = GroundLevel(grid);
   // The ground of every cell holding a return (those with a lowest return; never on the grid's
@@ -503,17 +538,8 @@ void Preprocessor::RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts,
   }
 }
 
-void Preprocessor::BinLowestReturns(const GroundGrid& grid, const WorldPoints& pts) {
-  const double cell = params_.ground_cell;
-  const int side = grid.side;
-  cell_min_.assign(static_cast<std::size_t>(side) * side, std::numeric_limits<float>::infinity());
-  const std::size_t n = pts.size();
-  point_cell_.resize(n);
-  const double* const px = pts.x.data();
-  const double* const py = pts.y.data();
-  const float* const ph = pts.height.data();
-  std::int32_t* const pc = point_cell_.data();
-  float* const cmin = cell_min_.data();
+void Preprocessor::GroundGrid::Bin(const double* x, const double* y, const float* height,
+                                    std::size_t n, std::int32_t* cells, float* lowest) const {
   // Within max_range of the sensor, hence inside the grid (with one spare ring of cells) — unless
   // the ego pose jumps within the sweep: clamped before the conversion to int (which would be
   // undefined for a return 1e9 m away; found by tests/fuzz/tracker_fuzzer.cc), NaN to the edge.
@@ -529,46 +555,21 @@ void Preprocessor::BinLowestReturns(const GroundGrid& grid, const WorldPoints& p
     c = c > last ? last : c;
     return static_cast<std::int32_t>(c >= 1.0 ? c : 1.0);
   };
-  const double x0 = grid.x0, y0 = grid.y0;
-  const auto bin = [&](std::size_t begin, std::size_t end, float* lowest) {
-    std::int32_t* __restrict const cells = pc + begin;
-    const double* __restrict const xs = px + begin;
-    const double* __restrict const ys = py + begin;
-    const std::size_t n_run = end - begin;
-    if (exact_inverse) {
-      for (std::size_t k = 0; k < n_run; ++k) {
-        cells[k] = cell_of((ys[k] - y0) * inv_cell) * side + cell_of((xs[k] - x0) * inv_cell);
-      }
-    } else {
-      for (std::size_t k = 0; k < n_run; ++k) {
-        cells[k] = cell_of((ys[k] - y0) / cell) * side + cell_of((xs[k] - x0) / cell);
-      }
+  const double gx = x0, gy = y0, size = cell;
+  const int s = side;
+  std::int32_t* __restrict const out = cells;
+  const double* __restrict const xs = x;
+  const double* __restrict const ys = y;
+  if (exact_inverse) {
+    for (std::size_t k = 0; k < n; ++k) {
+      out[k] = cell_of((ys[k] - gy) * inv_cell) * s + cell_of((xs[k] - gx) * inv_cell);
     }
-    for (std::size_t i = begin; i < end; ++i) lowest[pc[i]] = std::min(lowest[pc[i]], ph[i]);
-  };
-  // In chunks, one per thread, each with a grid of its own (the first: cell_min_), then the
-  // lowest of each cell over the grids: a minimum, the same in any order. Only while a grid is
-  // no larger than the returns (1 m cells within 80 m: 26,569 cells), else on this thread.
-  const std::size_t num_cells = cell_min_.size();
-  const int chunks = num_cells <= n ? ChunksFor(n, pool_) : 1;
-  if (chunks == 1) {
-    bin(0, n, cmin);
-    return;
-  }
-  worker_cell_min_.resize(static_cast<std::size_t>(chunks) - 1);
-  pool_->ParallelFor(static_cast<std::size_t>(chunks), [&](std::size_t c, int) {
-    float* lowest = cmin;
-    if (c > 0) {
-      std::vector<float>& own = worker_cell_min_[c - 1];
-      own.assign(num_cells, std::numeric_limits<float>::infinity());
-      lowest = own.data();
+  } else {
+    for (std::size_t k = 0; k < n; ++k) {
+      out[k] = cell_of((ys[k] - gy) / size) * s + cell_of((xs[k] - gx) / size);
     }
-    bin(ChunkBegin(n, static_cast<int>(c), chunks), ChunkBegin(n, static_cast<int>(c) + 1, chunks),
-        lowest);
-  });
-  for (const std::vector<float>& own : worker_cell_min_) {
-    for (std::size_t c = 0; c < num_cells; ++c) cmin[c] = std::min(cmin[c], own[c]);
   }
+  for (std::size_t k = 0; k < n; ++k) lowest[cells[k]] = std::min(lowest[cells[k]], height[k]);
 }
 
 void Preprocessor::BoundByGrade(const GroundGrid& grid) {

@@ -147,22 +147,32 @@ class Preprocessor {
   // if a knot has no pose.
   bool ComputeKnots(const LadarScan& scan, const PoseHistory& poses,
                     std::int64_t max_extrapolation_us, PreprocessResult* result);
-  // Every usable return placed in the world (counts what is not in *stats).
-  void Compensate(const LadarScan& scan, PreprocessStats* stats, WorldPoints* out);
-  // The kept returns of [begin, end) of the scan (refusal_ says which) placed in the world,
-  // written to *out's arrays (sized already) from index first_out on; each refused one counted
-  // by its reason in refused[0, kNumRefusals).
-  void PlaceReturns(const LadarScan& scan, std::size_t begin, std::size_t end,
-                    std::size_t first_out, WorldPoints* out, std::int64_t* refused) const;
   // The ground grid (cells of ground_cell around the sensor, one spare ring at the edge).
   struct GroundGrid {
-    int side = 0;          // [cells]
-    double x0 = 0, y0 = 0; // [m] world corner
+    int side = 0;           // [cells]
+    double x0 = 0, y0 = 0;  // [m] world corner
+    double cell = 1.0;      // [m]
+    // The cell of each of n returns (x, y) into cells[0, n), each cell's lowest height
+    // lowered by theirs in lowest[].
+    void Bin(const double* x, const double* y, const float* height, std::size_t n,
+             std::int32_t* cells, float* lowest) const;
   };
+  GroundGrid MakeGroundGrid(const Eigen::Vector2d& center) const;
+  // Every usable return placed in the world (counts what is not in *stats); with grid (3-D
+  // clouds, grid ground), each also binned in it (point_cell_, cell_min_) in the same pass.
+  void Compensate(const LadarScan& scan, const GroundGrid* grid, PreprocessStats* stats,
+                  WorldPoints* out);
+  // The kept returns of [begin, end) of the scan (refusal_ says which) placed in the world,
+  // written to *out's arrays (sized already) from index first_out on; each refused one counted
+  // by its reason in refused[0, kNumRefusals); with grid, binned in it (the cell of output
+  // return k in cells[k]; lowest: this call's grid of lowest heights).
+  void PlaceReturns(const LadarScan& scan, std::size_t begin, std::size_t end,
+                    std::size_t first_out, const GroundGrid* grid, std::int32_t* cells,
+                    float* lowest, WorldPoints* out, std::int64_t* refused) const;
   // Ground: per cell the local ground height (the lowest return around, bounded by the scan's
   // level and the grade), and returns within [min_height, max_height] above it kept.
-  void RemoveGround(const Eigen::Vector2d& center, WorldPoints* pts, PreprocessStats* stats);
-  void BinLowestReturns(const GroundGrid& grid, const WorldPoints& pts);
+  // The returns are binned (Compensate).
+  void RemoveGround(const GroundGrid& grid, WorldPoints* pts, PreprocessStats* stats);
   void BoundByGrade(const GroundGrid& grid);
   float GroundLevel(const GroundGrid& grid) const;
   // The ground of a cell, computed and stored in cell_ground_.

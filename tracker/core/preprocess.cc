@@ -478,6 +478,11 @@ Preprocessor::GroundGrid Preprocessor::MakeGroundGrid(const Eigen::Vector2d& cen
   grid.side = static_cast<int>(std::ceil(2.0 * params_.max_range / grid.cell)) + 3;
   grid.x0 = center.x() - 0.5 * grid.side * grid.cell;
   grid.y0 = center.y() - 0.5 * grid.side * grid.cell;
+  // offset / cell by a multiplication when 1 / cell is exact (cell a power of two, as the default
+  // 1 m): the same quotient without a division per return.
+  int cell_exp = 0;
+  grid.exact_inverse = std::frexp(grid.cell, &cell_exp) == 0.5;
+  grid.inv_cell = 1.0 / grid.cell;
   return grid;
 }
 
@@ -543,11 +548,7 @@ void Preprocessor::GroundGrid::Bin(const double* x, const double* y, const float
   // Within max_range of the sensor, hence inside the grid (with one spare ring of cells) — unless
   // the ego pose jumps within the sweep: clamped before the conversion to int (which would be
   // undefined for a return 1e9 m away; found by tests/fuzz/tracker_fuzzer.cc), NaN to the edge.
-  // offset / cell, by a multiplication when 1 / cell is exact (cell a power of two, as the
-  // default 1 m): the same quotient without a division per return.
-  int cell_exp = 0;
-  const bool exact_inverse = std::frexp(cell, &cell_exp) == 0.5;
-  const double inv_cell = 1.0 / cell;
+  // offset / cell, by a multiplication when 1 / cell is exact (exact_inverse).
   const double last = side - 2.0;
   // Without branches (selects that give the same cell: below 1, or NaN, to 1; beyond the last to
   // it), so that the compiler vectorises the loop; then each return's cell lowered, in order.
@@ -555,14 +556,14 @@ void Preprocessor::GroundGrid::Bin(const double* x, const double* y, const float
     c = c > last ? last : c;
     return static_cast<std::int32_t>(c >= 1.0 ? c : 1.0);
   };
-  const double gx = x0, gy = y0, size = cell;
+  const double gx = x0, gy = y0, size = cell, inv = inv_cell;
   const int s = side;
   std::int32_t* __restrict const out = cells;
   const double* __restrict const xs = x;
   const double* __restrict const ys = y;
   if (exact_inverse) {
     for (std::size_t k = 0; k < n; ++k) {
-      out[k] = cell_of((ys[k] - gy) * inv_cell) * s + cell_of((xs[k] - gx) * inv_cell);
+      out[k] = cell_of((ys[k] - gy) * inv) * s + cell_of((xs[k] - gx) * inv);
     }
   } else {
     for (std::size_t k = 0; k < n; ++k) {

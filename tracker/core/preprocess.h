@@ -152,6 +152,8 @@ class Preprocessor {
     int side = 0;           // [cells]
     double x0 = 0, y0 = 0;  // [m] world corner
     double cell = 1.0;      // [m]
+    double inv_cell = 1.0;  // [1/m] 1 / cell
+    bool exact_inverse = true;  // 1 / cell is exact (cell a power of two): x * inv_cell = x / cell
     // The cell of each of n returns (x, y) into cells[0, n), each cell's lowest height
     // lowered by theirs in lowest[].
     void Bin(const double* x, const double* y, const float* height, std::size_t n,

@@ -296,6 +296,44 @@ void Preprocessor::Compensate(const LadarScan& scan, const GroundGrid* grid,
   out->ring.resize(kept);
 }
 
+namespace {
+
+// Places returns [0, n) of one knot interval (x, y, z in the sensor frame; dt null: each at the
+// interval's start lo, else dt[m] - lo microseconds into it) into wx, wy (world) and wh (body
+// height): rows x and y of the rotation at the interval's start (rotation rows 0-1) and their
+// rates per microsecond (rows 2-3) in single precision, the translation and its rate in double.
+// The operations of one return at a time, lane by lane, which the compiler vectorises.
+void PlaceRun(const Eigen::Matrix<float, 4, 3>& rotation, const Eigen::Vector2d& translation,
+              const Eigen::Vector2d& rate, const Eigen::Vector4f& body_z,
+              const float* __restrict px, const float* __restrict py, const float* __restrict pz,
+              const std::int32_t* __restrict dt, std::int32_t lo, std::size_t n,
+              double* __restrict wx, double* __restrict wy, float* __restrict wh) {
+  const float r00 = rotation(0, 0), r01 = rotation(0, 1), r02 = rotation(0, 2);
+  const float r10 = rotation(1, 0), r11 = rotation(1, 1), r12 = rotation(1, 2);
+  const float d00 = rotation(2, 0), d01 = rotation(2, 1), d02 = rotation(2, 2);
+  const float d10 = rotation(3, 0), d11 = rotation(3, 1), d12 = rotation(3, 2);
+  const double tx = translation.x(), ty = translation.y(), vx = rate.x(), vy = rate.y();
+  const float bz0 = body_z(0), bz1 = body_z(1), bz2 = body_z(2), bz3 = body_z(3);
+  const auto place = [&](std::size_t m, float u) {
+    const float x = px[m], y = py[m], z = pz[m];
+    const float a = r00 * x + r01 * y + r02 * z;
+    const float b = r10 * x + r11 * y + r12 * z;
+    const float da = d00 * x + d01 * y + d02 * z;
+    const float db = d10 * x + d11 * y + d12 * z;
+    const double ud = static_cast<double>(u);
+    wx[m] = (tx + ud * vx) + static_cast<double>(a + u * da);
+    wy[m] = (ty + ud * vy) + static_cast<double>(b + u * db);
+    wh[m] = bz0 * x + bz1 * y + bz2 * z + bz3;
+  };
+  if (dt != nullptr) {
+    for (std::size_t m = 0; m < n; ++m) place(m, static_cast<float>(dt[m] - lo));
+  } else {
+    for (std::size_t m = 0; m < n; ++m) place(m, 0.0f);
+  }
+}
+
+}  // namespace
+
 void Preprocessor::PlaceReturns(const LadarScan& scan, std::size_t begin, std::size_t end,
                                 std::size_t first_out, const GroundGrid* grid,
                                 std::int32_t* cells, float* lowest, WorldPoints* out,
@@ -304,7 +342,6 @@ void Preprocessor::PlaceReturns(const LadarScan& scan, std::size_t begin, std::s
   const std::int64_t last_interval = static_cast<std::int64_t>(knots_.size()) - 1;
   // Body-frame height of a return: the z row of body_from_sensor (the mounting is rigid).
   const Eigen::Vector4f body_z = scan.body_from_sensor.matrix().row(2).transpose().cast<float>();
-  const float bz0 = body_z(0), bz1 = body_z(1), bz2 = body_z(2), bz3 = body_z(3);
   // dt / step without a 64-bit division per return: a floating-point guess, corrected to the
   // exact quotient.
   const double inv_step = 1.0 / static_cast<double>(step);
@@ -350,40 +387,13 @@ void Preprocessor::PlaceReturns(const LadarScan& scan, std::size_t begin, std::s
     } else {
       while (run_end < end && refusal[run_end] == ReturnFilter::kKept) ++run_end;
     }
-    // The run: the same operations as for one return at a time, lane by lane (rows x and y of
-    // the rotation and their rates; the translation in double), which the compiler vectorises.
-    const Knot& knot = knots[k];
-    const float r00 = knot.rotation(0, 0), r01 = knot.rotation(0, 1), r02 = knot.rotation(0, 2);
-    const float r10 = knot.rotation(1, 0), r11 = knot.rotation(1, 1), r12 = knot.rotation(1, 2);
-    const float d00 = knot.rotation(2, 0), d01 = knot.rotation(2, 1), d02 = knot.rotation(2, 2);
-    const float d10 = knot.rotation(3, 0), d11 = knot.rotation(3, 1), d12 = knot.rotation(3, 2);
-    const double tx = knot.translation.x(), ty = knot.translation.y();
-    const double vx = knot.translation_rate.x(), vy = knot.translation_rate.y();
     const std::size_t n = run_end - i;
-    const float* __restrict const px = sx + i;
-    const float* __restrict const py = sy + i;
-    const float* __restrict const pz = sz + i;
-    double* __restrict const wx = ox + w;
-    double* __restrict const wy = oy + w;
-    float* __restrict const wh = oh + w;
-    const auto place = [&](std::size_t m, float u) {
-      const float x = px[m], y = py[m], z = pz[m];
-      const float a = r00 * x + r01 * y + r02 * z;
-      const float b = r10 * x + r11 * y + r12 * z;
-      const float da = d00 * x + d01 * y + d02 * z;
-      const float db = d10 * x + d11 * y + d12 * z;
-      const double ud = static_cast<double>(u);
-      wx[m] = (tx + ud * vx) + static_cast<double>(a + u * da);
-      wy[m] = (ty + ud * vy) + static_cast<double>(b + u * db);
-      wh[m] = bz0 * x + bz1 * y + bz2 * z + bz3;
-    };
-    if (dts != nullptr) {
-      const std::int32_t* __restrict const dt_run = dts + i;
-      const std::int32_t lo32 = static_cast<std::int32_t>(lo);
-      for (std::size_t m = 0; m < n; ++m) place(m, static_cast<float>(dt_run[m] - lo32));
-    } else {
-      for (std::size_t m = 0; m < n; ++m) place(m, 0.0f);
-    }
+    double* const wx = ox + w;
+    double* const wy = oy + w;
+    float* const wh = oh + w;
+    PlaceRun(knots[k].rotation, knots[k].translation, knots[k].translation_rate, body_z, sx + i,
+             sy + i, sz + i, dts != nullptr ? dts + i : nullptr, static_cast<std::int32_t>(lo), n,
+             wx, wy, wh);
     for (std::size_t m = 0; m < n; ++m) {
       oi[w + m] = static_cast<std::int32_t>(i + m);
       orng[w + m] = sring != nullptr ? sring[i + m] : std::int16_t{0};

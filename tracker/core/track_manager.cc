@@ -427,12 +427,23 @@ double TrackManager::ObserveEvidence(std::size_t index, const ReturnEvidence& r,
 
 bool TrackManager::Create(const PointSet& points, const Eigen::Vector2d& sensor_xy,
                           std::uint64_t seed, const RangeProfile* profile) {
-  measurer_.set_profile(profile);
-  Track t;
+  NewTrack t;
+  if (!PrepareCreate(points, sensor_xy, seed, profile, &measurer_, &t)) return false;
+  AddCreated(std::move(t));
+  return true;
+}
+
+bool TrackManager::PrepareCreate(const PointSet& points, const Eigen::Vector2d& sensor_xy,
+                                 std::uint64_t seed, const RangeProfile* profile,
+                                 TrackMeasurer* measurer, NewTrack* out) const {
+  measurer->set_profile(profile);
+  Track& t = out->track;
+  t = Track{};
   t.small_object = points.extent < params_.small_object_extent;
-  TrackHypothesis h = FirstHypothesis();
+  TrackHypothesis& h = out->hypothesis;
+  h = FirstHypothesis();
   CentreMeasurement m;
-  if (!measurer_.Measure(t.small_object, points, sensor_xy, seed, std::nullopt, std::nullopt,
+  if (!measurer->Measure(t.small_object, points, sensor_xy, seed, std::nullopt, std::nullopt,
                          &h, &m)) {
     return false;
   }
@@ -440,8 +451,12 @@ bool TrackManager::Create(const PointSet& points, const Eigen::Vector2d& sensor_
   StartFilter(m, &h);
   ObserveFirstShape(t.small_object, points, profile != nullptr, &h);
   SnapshotReturns(points, &t.last_returns);
-  AddTrack(std::move(t), std::move(h), points.mean_utime);
+  out->utime = points.mean_utime;
   return true;
+}
+
+void TrackManager::AddCreated(NewTrack&& t) {
+  AddTrack(std::move(t.track), std::move(t.hypothesis), t.utime);
 }
 
 void TrackManager::ObserveFitDimensions(double time_s, bool three_d, TrackHypothesis* h) const {

@@ -146,6 +146,18 @@ class TrackManager {
   // profile (optional, 3-D scans): as for Update (the see-through test, weighted dimensions).
   bool Create(const PointSet& points, const Eigen::Vector2d& sensor_xy, std::uint64_t seed,
               const RangeProfile* profile = nullptr);
+  // Create in two steps, so that the new objects of a scan can be measured at once, each on its
+  // own thread: PrepareCreate measures a track from the points and changes nothing (false if
+  // they cannot be measured; measurer: as for Update, its buffers scratch), AddCreated adds it
+  // with the next id. Create is the two in a row with the manager's own fitter.
+  struct NewTrack {
+    Track track;
+    TrackHypothesis hypothesis;
+    std::int64_t utime = 0;
+  };
+  bool PrepareCreate(const PointSet& points, const Eigen::Vector2d& sensor_xy, std::uint64_t seed,
+                     const RangeProfile* profile, TrackMeasurer* measurer, NewTrack* out) const;
+  void AddCreated(NewTrack&& t);
   // Life cycle after a scan at utime: confirmation, coasting, deletion, duplicates.
   void EndScan(std::int64_t utime);
   // Every track, its reported hypothesis predicted to utime.

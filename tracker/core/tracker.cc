@@ -341,15 +341,18 @@ void Tracker::IndexSegments() {
   }
 }
 
-bool Tracker::ObserveEvidence(std::size_t index, const std::vector<std::int32_t>& idx,
-                              const Eigen::Vector2d& sensor_xy, bool three_d, Worker* w,
-                              ScanOutput::EvidenceRow* row) {
-  const ReturnEvidence r =
-      MeasureReturns(points_, idx, segment_of_, segment_extent_, sensor_xy, three_d, top_ring_,
-                     record_evidence_ || hidden_ends_used_[three_d ? 1 : 0] ? &profile_ : nullptr,
-                     &w->evidence_scratch,
-                     record_evidence_ || roughness_used_[three_d ? 1 : 0] ? &w->roughness_scratch : nullptr,
-                     record_evidence_ || column_top_used_[three_d ? 1 : 0]);
+ReturnEvidence Tracker::MeasureEvidence(const std::vector<std::int32_t>& idx,
+                                        const Eigen::Vector2d& sensor_xy, bool three_d,
+                                        Worker* w) const {
+  return MeasureReturns(points_, idx, segment_of_, segment_extent_, sensor_xy, three_d, top_ring_,
+                        record_evidence_ || hidden_ends_used_[three_d ? 1 : 0] ? &profile_ : nullptr,
+                        &w->evidence_scratch,
+                        record_evidence_ || roughness_used_[three_d ? 1 : 0] ? &w->roughness_scratch : nullptr,
+                        record_evidence_ || column_top_used_[three_d ? 1 : 0]);
+}
+
+bool Tracker::ApplyEvidence(std::size_t index, const ReturnEvidence& r, bool three_d,
+                            ScanOutput::EvidenceRow* row) {
   row->logit = manager_->ObserveEvidence(index, r, record_evidence_ ? &row->features : nullptr);
   if (!record_evidence_) return false;
   const Track& t = manager_->tracks()[index];
@@ -359,27 +362,45 @@ bool Tracker::ObserveEvidence(std::size_t index, const std::vector<std::int32_t>
   return true;
 }
 
+bool Tracker::ObserveEvidence(std::size_t index, const std::vector<std::int32_t>& idx,
+                              const Eigen::Vector2d& sensor_xy, bool three_d, Worker* w,
+                              ScanOutput::EvidenceRow* row) {
+  return ApplyEvidence(index, MeasureEvidence(idx, sensor_xy, three_d, w), three_d, row);
+}
+
 void Tracker::CreateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_xy,
                            ScanOutput* out) {
   auto& objs = association_.new_objects;
   OrderNewObjects(points_, params_.manager.small_object_extent, &objs);
+  const bool three_d = scan.num_rings > 1;
+  // Each new object measured on the pool: its outline, its track (TrackManager::PrepareCreate)
+  // and its vehicle-evidence features, each reading the scan and writing its own result with its
+  // worker's scratch. Then, in their order, each becomes a track unless it lies on a rectangle
+  // created before it from this scan (CreatedRectangles): the tracks one object after the other
+  // would give. Those on a rectangle (about 8 % of KITTI 0000's) were measured in vain.
+  new_objects_.resize(objs.size());
+  pool_->ParallelFor(objs.size(), [&](std::size_t k, int wi) {
+    NewObject& o = new_objects_[k];
+    o.measured = false;
+    const auto& idx = objs[k];
+    if (idx.empty()) return;
+    Worker& w = workers_[static_cast<std::size_t>(wi)];
+    w.outline.Extract(points_, idx, scan, sensor_xy, &w.point_set);
+    if (w.point_set.size() == 0) return;
+    o.measured = manager_->PrepareCreate(
+        w.point_set, sensor_xy, RansacSeed(seed_, scan.utime, -1 - static_cast<std::int64_t>(k)),
+        three_d ? &profile_ : nullptr, &w.measurer, &o.track);
+    if (o.measured) o.evidence = MeasureEvidence(idx, sensor_xy, three_d, &w);
+  });
   created_.Clear();
   for (std::size_t k = 0; k < objs.size(); ++k) {
-    const auto& idx = objs[k];
-    if (idx.empty() || created_.Holds(points_, idx)) continue;
-    Worker& w = workers_.front();
-    w.outline.Extract(points_, idx, scan, sensor_xy, &w.point_set);
-    if (w.point_set.size() == 0) continue;
-    if (manager_->Create(w.point_set, sensor_xy,
-                         RansacSeed(seed_, scan.utime, -1 - static_cast<std::int64_t>(k)),
-                         scan.num_rings > 1 ? &profile_ : nullptr)) {
-      const std::size_t index = manager_->tracks().size() - 1;
-      created_.Add(manager_->Box(index));
-      ScanOutput::EvidenceRow row;
-      if (ObserveEvidence(index, idx, sensor_xy, scan.num_rings > 1, &w, &row)) {
-        out->evidence.push_back(row);
-      }
-    }
+    NewObject& o = new_objects_[k];
+    if (!o.measured || created_.Holds(points_, objs[k])) continue;
+    manager_->AddCreated(std::move(o.track));
+    const std::size_t index = manager_->tracks().size() - 1;
+    created_.Add(manager_->Box(index));
+    ScanOutput::EvidenceRow row;
+    if (ApplyEvidence(index, o.evidence, three_d, &row)) out->evidence.push_back(row);
   }
 }
 

@@ -158,6 +158,18 @@ class Tracker {
   bool ObserveEvidence(std::size_t index, const std::vector<std::int32_t>& idx,
                        const Eigen::Vector2d& sensor_xy, bool three_d, Worker* w,
                        ScanOutput::EvidenceRow* row);
+  // The two halves of ObserveEvidence: the features of returns idx (reads the scan only, on
+  // worker w), and their logit added to track index's log-odds.
+  ReturnEvidence MeasureEvidence(const std::vector<std::int32_t>& idx,
+                                 const Eigen::Vector2d& sensor_xy, bool three_d, Worker* w) const;
+  bool ApplyEvidence(std::size_t index, const ReturnEvidence& r, bool three_d,
+                     ScanOutput::EvidenceRow* row);
+  // A new object of the scan, measured (CreateTracks).
+  struct NewObject {
+    bool measured = false;
+    TrackManager::NewTrack track;
+    ReturnEvidence evidence;
+  };
 
   TrackerParams params_;
   bool debug_;
@@ -180,6 +192,7 @@ class Tracker {
   std::vector<PredictedObject> predicted_;
   AssociationResult association_;
   std::vector<TrackUpdateOutput> update_out_;  // per track of the scan being processed
+  std::vector<NewObject> new_objects_;         // per new object of the scan being processed
   RangeProfile profile_;  // nearest return per bearing of the scan being processed
   std::vector<char> unobserved_;  // per track: in a lost wedge of the scan being processed
   std::vector<AzimuthWedge> lost_world_;  // the scan's lost wedges as world bearings [rad]

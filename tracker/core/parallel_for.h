@@ -20,8 +20,8 @@ namespace vtrack {
 
 // A fixed set of threads, started once, that share the calls of index loops (ParallelFor).
 // Started once rather than per loop: starting and joining a thread costs about 60 us of system
-// time on a 2-core virtual machine (median of 2,000), and the tracker runs four such loops per
-// scan.
+// time on a 2-core virtual machine (median of 2,000), and the tracker runs several such loops
+// per scan (docs/design.md, section 9).
 //
 // Written with std::thread rather than OpenMP: the tracker's builds include clang's sanitizer
 // and fuzzing builds, where OpenMP needs another runtime (libomp) and is opaque to

@@ -740,7 +740,7 @@ struct ComputeParams {
   void Visit(V& v) {
     using namespace param;
     v("pin_threads", &pin_threads, {"-", {}, "pins the pool's threads in a process that allows it (Tracker::AllowThreadPinning: the live vtrack-tracker), where it may use exactly as many CPUs as threads (a 2-CPU machine, or CPUs chosen with taskset): each thread on its own, the tracker's thread on the first; unpinned, a worker woken after the ~90 ms between sweeps is placed beside the tracker's thread and the two run in turn (KITTI 0000 at 10 Hz, 2 CPUs, wall ms: median 9.3-9.9 pinned against 12.7-13.1 unpinned, p99 13.1-14.1 against 17.5-18.1; over LCM the p99 varies from run to run by more than that: docs/speed.md). With more CPUs nothing is pinned; vtrack-tracker --input never pins"});
-    v("threads", &threads, {"-", Closed(1, 64), "threads that share a scan's loops: the returns' placement and ground cells, the range profile beside the segmentation, the tracks' candidate pairs and their updates (each part independent of the others); 1: all on the calling thread. 2 on a 2-core computer: KITTI 0000 bench, see docs/results.md and docs/speed.md"});
+    v("threads", &threads, {"-", Closed(1, 64), "threads that share a scan's loops: the returns' placement and ground cells, the range profile beside the segmentation, the tracks' candidate pairs, their updates and the new objects' measurement (each part independent of the others); 1: all on the calling thread. 2 on a 2-core computer: KITTI 0000 bench, see docs/results.md and docs/speed.md"});
   }
   bool Validate(std::string* error) const { return param::Validate(*this, error); }
 };

@@ -232,12 +232,17 @@ void Preprocessor::Compensate(const LadarScan& scan, const GroundGrid* grid,
   out->height.resize(n);
   out->index.resize(n);
   out->ring.resize(n);
+  out->column_top.clear();  // the grid ground's (RemoveGround); none otherwise
   refusal_.resize(n);
   const ReturnFilter filter(scan, params_);
   filter.Classify(scan, refusal_.data());
   // The returns in chunks, one per thread, each written from where the kept returns before it
-  // end: the same arrays, in the same order, as one pass would write.
-  const int chunks = ChunksFor(n, pool_);
+  // end: the same arrays, in the same order, as one pass would write. Binned in the ground grid
+  // as they are placed, each chunk lowers a grid of its own (below): only while the grid is no
+  // larger than the returns (1 m cells within 80 m: 26,569 cells), else on this thread alone
+  // (a grid of 0.1 m cells would have each thread fill and the caller merge 2.6 M cells).
+  const std::size_t num_cells = grid != nullptr ? static_cast<std::size_t>(grid->side) * grid->side : 0;
+  const int chunks = num_cells <= n ? ChunksFor(n, pool_) : 1;
   std::vector<std::size_t> first_out(static_cast<std::size_t>(chunks) + 1, 0);
   for (int c = 0; c < chunks; ++c) {
     first_out[static_cast<std::size_t>(c) + 1] =
@@ -246,10 +251,8 @@ void Preprocessor::Compensate(const LadarScan& scan, const GroundGrid* grid,
                                             refusal_.begin() + static_cast<std::ptrdiff_t>(ChunkBegin(n, c + 1, chunks)),
                                             std::uint8_t{ReturnFilter::kKept}));
   }
-  // Binned in the ground grid as they are placed: each chunk lowers a grid of its own (the
-  // first: cell_min_), then each cell takes the lowest over the grids (a minimum: the same in
-  // any order).
-  const std::size_t num_cells = grid != nullptr ? static_cast<std::size_t>(grid->side) * grid->side : 0;
+  // The chunks' grids of lowest returns (the first: cell_min_), then each cell the lowest over
+  // them (a minimum: the same in any order).
   if (grid != nullptr) {
     cell_min_.assign(num_cells, std::numeric_limits<float>::infinity());
     point_cell_.resize(n);

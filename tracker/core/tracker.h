@@ -133,7 +133,7 @@ class Tracker {
   void CreateTracks(const LadarScan& scan, const Eigen::Vector2d& sensor_xy, ScanOutput* out);
   // The segment of every return and each segment's extent (for the vehicle evidence).
   void IndexSegments();
-  // What one thread of UpdateTracks (and CreateTracks: the first) works with.
+  // What one thread of UpdateTracks and CreateTracks works with.
   struct Worker {
     Worker(const OutlineParams& outline_params, TrackMeasurer m)
         : outline(outline_params), measurer(std::move(m)) {}

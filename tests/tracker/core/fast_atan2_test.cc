@@ -4,7 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "tracker/core/fast_atan2.h"
 
@@ -25,6 +28,48 @@ TEST(Atan2ApproxTest, WithinBoundOfStdAtan2OverRandomDirections) {
   EXPECT_LT(worst, kAtan2ApproxMaxError);
   // The bound is not loose by orders of magnitude either way: the series' truncation shows.
   EXPECT_GT(worst, 1e-16);
+}
+
+// Two at a time (the range profile's loop): each lane within the bound of std::atan2 and exactly
+// the value of its own inputs one at a time, whatever the other lane holds (a lane's select must
+// not take the other's condition), over random pairs mixed with the axes, the diagonals
+// (|x| = |y|), the reduction threshold, zeros and NaN.
+TEST(Atan2ApproxTest, TwoLanesGiveEachItsOwnValue) {
+  std::mt19937_64 rng(20261201);
+  std::uniform_real_distribution<double> angle(-M_PI, M_PI);
+  std::uniform_real_distribution<double> log_range(-3.0, 3.0);
+  const double t12 = 2.0 - std::sqrt(3.0);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::pair<double, double>> special = {
+      {0.0, 1.0}, {1.0, 0.0}, {0.0, -1.0}, {-1.0, 0.0}, {0.0, 0.0}, {2.5, 2.5}, {-2.5, 2.5},
+      {2.5, -2.5}, {-2.5, -2.5}, {t12, 1.0}, {-1.0, -t12}, {nan, 1.0}, {1.0, nan}};
+  int checked = 0;
+  for (int k = 0; k < 200000; ++k) {
+    std::pair<double, double> in[2];
+    for (auto& p : in) {
+      if (k % 7 == 0) {
+        p = special[static_cast<std::size_t>(rng() % special.size())];
+      } else {
+        const double r = std::pow(10.0, log_range(rng)), a = angle(rng);
+        p = {r * std::sin(a), r * std::cos(a)};
+      }
+    }
+    const Double2 v = Atan2Approx2(Double2{in[0].first, in[1].first}, Double2{in[0].second, in[1].second});
+    for (int lane = 0; lane < 2; ++lane) {
+      const auto [y, x] = in[lane];
+      const double one = Atan2Approx(y, x);
+      if (std::isnan(one)) {
+        EXPECT_TRUE(std::isnan(v[lane])) << "y " << y << " x " << x;
+      } else {
+        EXPECT_EQ(v[lane], one) << "lane " << lane << " y " << y << " x " << x;
+      }
+      if (std::isfinite(y) && std::isfinite(x) && (x != 0.0 || y != 0.0)) {
+        EXPECT_NEAR(v[lane], std::atan2(y, x), kAtan2ApproxMaxError) << "y " << y << " x " << x;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 300000);
 }
 
 TEST(Atan2ApproxTest, ExactStructureAtAxesAndOctantBoundaries) {

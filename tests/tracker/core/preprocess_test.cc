@@ -472,14 +472,19 @@ TEST(PreprocessTest, GridGroundRemovalKeepsObjectsAndDropsRoad) {
   EXPECT_EQ(kept_object, num_object);
   EXPECT_LT(kept_ground, 20);
   EXPECT_EQ(res.stats.ground + res.stats.kept, res.stats.input - res.stats.out_of_range);
+  // The grid ground gives every kept return its column's top (a vehicle-evidence feature).
+  EXPECT_EQ(out.column_top.size(), out.size());
 
   // The fixed band at the wrong height keeps much of the sloped road far away: grid is needed.
+  // Into the same arrays: the band gives no column tops, and none are left from the grid's run
+  // (the evidence reads them wherever there is one per return).
   params.ground = PreprocessParams::Ground::kBand;
   Preprocessor band(params);
   band.Run(scan, poses, 0, &out);
   int band_ground = 0;
   for (std::size_t k = 0; k < out.size(); ++k) band_ground += !is_object[static_cast<std::size_t>(out.index[k])];
   EXPECT_GT(band_ground, 1000);
+  EXPECT_TRUE(out.column_top.empty()) << out.column_top.size() << " column tops left";
 }
 
 // A flat road seen everywhere except in the shadow of a nearer car (x 22-60 m, y -1.75 to 5.25),

@@ -14,10 +14,12 @@
 //    100 ms after the one before, as a live tracker gets them (it sleeps in between), with the
 //    pool's threads pinned to CPUs of their own (compute.pin_threads, shipped) and not.
 // Counters per benchmark: median_ms / p99_ms / wall_median_ms over the timed scans and, for the
-// 3-D sequences, the stage breakdown (median ms): pre_ms (compensation + ground), seg_ms,
-// assoc_ms (prediction + association) measured by running those stages alone on the same input
-// and tracker state just before the scan, and rest_ms = total - those (per-track fitting, EKF
-// updates, hypothesis management, new tracks, life cycle, report).
+// 3-D sequences, where the time goes (median ms of the process's CPU time per stage, read in the
+// timed run itself at the stages' ends, Tracker::SetStageClock): pre_ms (compensation + ground),
+// seg_ms (segmentation and grazing pieces, beside the range profile and the tracks' prediction),
+// assoc_ms (association), upd_ms (every track's update: outline, fit, filters, hypotheses,
+// evidence), new_ms (new tracks), life_ms (life cycle and report), and rest_ms = total - pre_ms -
+// seg_ms - assoc_ms (the last three and the sequencing around the pipeline).
 //  - BM_CopyFloor_Kitti: the physical floor, a plain copy of each scan's point arrays (x, y, z,
 //    intensity, dt_us, ring) into buffers allocated once.
 //  - BM_PointsScaling/N: KITTI frames resampled to N = 10k..1M returns per scan (every k-th return
@@ -70,35 +72,6 @@ double WallSeconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-// The stages before the per-track updates, run alone on the tracker's state and the scan.
-struct StageProbe {
-  explicit StageProbe(const TrackerParams& p)
-      : params(p), pre(p.preprocess), seg(p.segmentation), assoc(p.association) {}
-  // Adds the CPU seconds of each stage to pre_s, seg_s, assoc_s.
-  void Run(const LadarScan& scan, const PoseHistory& poses, const TrackManager& manager) {
-    const double t0 = ThreadCpuSeconds();
-    const PreprocessResult r = pre.Run(scan, poses, 0, &points);
-    const double t1 = ThreadCpuSeconds();
-    seg.Run(points, scan.num_rings <= 1, r.sensor_xy, &segments);
-    const double t2 = ThreadCpuSeconds();
-    manager.Predict(scan.utime + scan.sweep_duration_us / 2, &predicted);
-    assoc.Run(predicted, points, segments, r.sensor_xy, &result);
-    const double t3 = ThreadCpuSeconds();
-    pre_s = t1 - t0;
-    seg_s = t2 - t1;
-    assoc_s = t3 - t2;
-  }
-  TrackerParams params;
-  Preprocessor pre;
-  Segmenter seg;
-  Associator assoc;
-  WorldPoints points;
-  Segments segments;
-  std::vector<PredictedObject> predicted;
-  AssociationResult result;
-  double pre_s = 0, seg_s = 0, assoc_s = 0;
-};
-
 // The shipped parameters with compute.threads = n.
 TrackerParams Threads(int n) {
   TrackerParams p = bench::ShippedParams();
@@ -121,12 +94,14 @@ void RunSequence(benchmark::State& state, const Sequence& seq, int warmup, bool 
     return;
   }
   std::unique_ptr<Tracker> tracker;
-  std::unique_ptr<StageProbe> probe;
-  if (breakdown) probe = std::make_unique<StageProbe>(params);
-  const PoseHistory all_poses = bench::AllPoses(seq);
   std::size_t i = seq.scans.size();
   std::vector<ScanOutput> out;
-  std::vector<double> cpu_ms, wall_ms, pre_ms, seg_ms, assoc_ms, rest_ms;
+  std::vector<double> cpu_ms, wall_ms;
+  // Per stage (ScanOutput::stages): pre, seg, assoc, upd, new, life; then rest.
+  constexpr int kStages = 7;
+  static const char* const kStageCounter[kStages] = {"pre_ms", "seg_ms", "assoc_ms", "upd_ms",
+                                                     "new_ms", "life_ms", "rest_ms"};
+  std::vector<double> stage_ms[kStages];
   double points = 0, tracks = 0;
   auto next_start = std::chrono::steady_clock::now();
   const auto wait_for_start = [&] {
@@ -137,6 +112,7 @@ void RunSequence(benchmark::State& state, const Sequence& seq, int warmup, bool 
   for (auto _ : state) {
     if (i >= seq.scans.size()) {
       tracker = std::make_unique<Tracker>(params);
+      if (breakdown) tracker->SetStageClock(ProcessCpuSeconds);
       for (i = 0; i < static_cast<std::size_t>(warmup); ++i) {
         for (const auto& p : seq.poses_before[i]) tracker->AddPose(p, &out);
         LadarScan copy = seq.scans[i];
@@ -145,7 +121,6 @@ void RunSequence(benchmark::State& state, const Sequence& seq, int warmup, bool 
       }
     }
     for (const auto& p : seq.poses_before[i]) tracker->AddPose(p, &out);
-    if (probe) probe->Run(seq.scans[i], all_poses, tracker->manager());
     LadarScan copy = seq.scans[i];
     points += static_cast<double>(copy.size());
     out.clear();
@@ -161,11 +136,12 @@ void RunSequence(benchmark::State& state, const Sequence& seq, int warmup, bool 
     tracks += static_cast<double>(out.back().tracks.size());
     cpu_ms.push_back(1e3 * (c1 - c0));
     wall_ms.push_back(1e3 * (w1 - w0));
-    if (probe) {
-      pre_ms.push_back(1e3 * probe->pre_s);
-      seg_ms.push_back(1e3 * probe->seg_s);
-      assoc_ms.push_back(1e3 * probe->assoc_s);
-      rest_ms.push_back(cpu_ms.back() - pre_ms.back() - seg_ms.back() - assoc_ms.back());
+    if (breakdown) {
+      const ScanOutput::StageSeconds& s = out.back().stages;
+      const double ms[kStages - 1] = {s.preprocess, s.segment, s.associate,
+                                      s.update,     s.create,  s.life_cycle};
+      for (int k = 0; k + 1 < kStages; ++k) stage_ms[k].push_back(1e3 * ms[k]);
+      stage_ms[kStages - 1].push_back(cpu_ms.back() - 1e3 * (ms[0] + ms[1] + ms[2]));
     }
     ++i;
   }
@@ -177,11 +153,10 @@ void RunSequence(benchmark::State& state, const Sequence& seq, int warmup, bool 
   state.counters["max_ms"] = bench::Percentile(cpu_ms, 100);
   state.counters["wall_median_ms"] = bench::Percentile(wall_ms, 50);
   state.counters["wall_p99_ms"] = bench::Percentile(wall_ms, 99);
-  if (probe) {
-    state.counters["pre_ms"] = bench::Percentile(pre_ms, 50);
-    state.counters["seg_ms"] = bench::Percentile(seg_ms, 50);
-    state.counters["assoc_ms"] = bench::Percentile(assoc_ms, 50);
-    state.counters["rest_ms"] = bench::Percentile(rest_ms, 50);
+  if (breakdown) {
+    for (int k = 0; k < kStages; ++k) {
+      state.counters[kStageCounter[k]] = bench::Percentile(stage_ms[k], 50);
+    }
   }
 }
 

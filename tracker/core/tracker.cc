@@ -171,9 +171,19 @@ bool Tracker::ProcessDetections(const DetectionList& list, bool extrapolate, Sca
 }
 
 bool Tracker::Process(const LadarScan& scan, bool extrapolate, ScanOutput* out) {
+  // The stage clock's reading, and the seconds since the last (ScanOutput::stages).
+  double stage_start = stage_clock_ ? stage_clock_() : 0.0;
+  const auto stage_end = [&](double* seconds) {
+    if (!stage_clock_) return;
+    const double now = stage_clock_();
+    *seconds = now - stage_start;
+    stage_start = now;
+  };
+  ScanOutput::StageSeconds& stages = out->stages;
   // Compensation and ground.
   PreprocessResult pre;
   if (!Preprocess(scan, extrapolate, &pre)) return false;
+  stage_end(&stages.preprocess);
   out->utime = scan.utime;
   out->seq = scan.seq;
   out->stats = pre.stats;
@@ -191,16 +201,21 @@ bool Tracker::Process(const LadarScan& scan, bool extrapolate, ScanOutput* out) 
     JoinGrazingPieces(points_, pre.sensor_xy, params_.grazing, &segments_);
     IndexSegments();
   });
+  stage_end(&stages.segment);
   // Association with the predicted tracks.
   associator_.Run(predicted_, points_, segments_, pre.sensor_xy, &association_);
   out->num_segments = static_cast<std::int32_t>(segments_.segments.size());
   top_ring_ = TopRing(scan);
   MarkUnobserved(scan, extrapolate);
+  stage_end(&stages.associate);
   // Each track updated with its returns; new tracks from what is left; life cycle; report.
   UpdateTracks(scan, pre.sensor_xy, out);
+  stage_end(&stages.update);
   CreateTracks(scan, pre.sensor_xy, out);
+  stage_end(&stages.create);
   manager_->EndScan(scan.utime);
   manager_->Report(scan.utime, &out->tracks);
+  stage_end(&stages.life_cycle);
   return true;
 }
 

@@ -20,6 +20,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -58,6 +59,20 @@ struct ScanOutput {
     double log_odds = 0.0;    // [-] the track's, after it
   };
   std::vector<EvidenceRow> evidence;
+  // Where the scan's time went, by the clock of Tracker::SetStageClock (all 0 without one):
+  // the stages of the pipeline in their order (docs/design.md, section 4), each run to its end
+  // on whichever threads it uses.
+  struct StageSeconds {
+    double preprocess = 0.0;    // [s] compensation, ground
+    double segment = 0.0;       // [s] segmentation and grazing pieces, beside the range profile
+                                //     and the tracks' prediction to mid-sweep
+    double associate = 0.0;     // [s] association
+    double update = 0.0;        // [s] every track's update (outline, fit, filters, hypotheses,
+                                //     evidence)
+    double create = 0.0;        // [s] new tracks
+    double life_cycle = 0.0;    // [s] life cycle and report
+  };
+  StageSeconds stages;
 };
 
 // A first track id larger than every id of a tracker started earlier (for a process that may be
@@ -97,6 +112,11 @@ class Tracker {
   std::size_t queued_scans() const { return sequencer_.queued_scans(); }
   // Events since the last call (for rate-limited warnings).
   std::vector<TrackerEvent> TakeEvents() { return rejects_.TakeEvents(); }
+
+  // A clock [s] (any origin; a process's CPU time, say) read at the stages' ends to fill
+  // ScanOutput::stages; none (the default, or an empty function): nothing is measured. The
+  // library itself reads no clock: its decisions depend on message time only.
+  void SetStageClock(std::function<double()> seconds) { stage_clock_ = std::move(seconds); }
 
   // Records every scan's vehicle-evidence features in ScanOutput::evidence.
   void SetRecordEvidence(bool on) { record_evidence_ = on; }
@@ -209,6 +229,7 @@ class Tracker {
   bool column_top_used_[2] = {false, false};
   std::int64_t returns_processed_ = 0;
   std::int64_t seed_ = 1;  // SetSeed
+  std::function<double()> stage_clock_;  // SetStageClock
 };
 
 }  // namespace vtrack

@@ -284,6 +284,48 @@ TEST(TrackerTest, SameInputGivesIdenticalOutput) {
   }
 }
 
+// ScanOutput::stages: each stage's time is the difference of the caller's clock between its end
+// and the one before (a clock that advances by a stage's own number of seconds at each reading
+// gives every stage that number, in the pipeline's order); without a clock nothing is measured,
+// and the tracks are the same either way (the library's decisions read no clock).
+TEST(TrackerTest, StageClockTimesEachStageAndChangesNoTrack) {
+  double now = 0.0;
+  int readings = 0;
+  const auto run = [&](bool clock) {
+    SyntheticScene scene(SceneConfig{}, TwoCars(), 44);
+    Tracker tracker(TrackerParams{});
+    // Reading k (from 0) advances the clock by k % 7 seconds: stage j of a scan (its j-th
+    // reading after the first) then takes j seconds.
+    if (clock) {
+      tracker.SetStageClock([&] {
+        now += static_cast<double>(readings++ % 7);
+        return now;
+      });
+    }
+    return RunScene(&tracker, &scene, 2.0);
+  };
+  const std::vector<ScanOutput> timed = run(true), plain = run(false);
+  ASSERT_GT(timed.size(), 10u);
+  EXPECT_EQ(readings, 7 * static_cast<int>(timed.size()));
+  ASSERT_EQ(timed.size(), plain.size());
+  for (std::size_t i = 0; i < timed.size(); ++i) {
+    const ScanOutput::StageSeconds& s = timed[i].stages;
+    EXPECT_EQ(s.preprocess, 1.0);
+    EXPECT_EQ(s.segment, 2.0);
+    EXPECT_EQ(s.associate, 3.0);
+    EXPECT_EQ(s.update, 4.0);
+    EXPECT_EQ(s.create, 5.0);
+    EXPECT_EQ(s.life_cycle, 6.0);
+    const ScanOutput::StageSeconds& z = plain[i].stages;
+    EXPECT_EQ(z.preprocess + z.segment + z.associate + z.update + z.create + z.life_cycle, 0.0);
+    ASSERT_EQ(timed[i].tracks.size(), plain[i].tracks.size());
+    for (std::size_t j = 0; j < timed[i].tracks.size(); ++j) {
+      EXPECT_EQ(timed[i].tracks[j].id, plain[i].tracks[j].id);
+      EXPECT_EQ(timed[i].tracks[j].x, plain[i].tracks[j].x);
+    }
+  }
+}
+
 // Where threads run is the process's to decide (Tracker::AllowThreadPinning): a tracker built
 // with the shipped parameters leaves its caller's thread where it was, unless the process
 // allows pinning, as vtrack-tracker does live. The calling thread's CPUs as the kernel reports

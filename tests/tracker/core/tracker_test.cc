@@ -284,6 +284,49 @@ TEST(TrackerTest, SameInputGivesIdenticalOutput) {
   }
 }
 
+// Section 4.8: new objects become tracks in their order (the larger first), and an object with
+// merge_fraction of its returns on a rectangle created before it from the same scan is part of
+// that object, not a new one. A single-plane scan of a car's corner 10 m ahead (two faces, 4.4 x
+// 1.8 m, 40 returns) and, after it in the scan (a range jump: its own segment), a small cluster
+// of 6 returns inside the car's rectangle: one track, and no second one started (no evidence row,
+// no id spent), with any number of threads (the objects are measured on the pool, then kept in
+// order).
+TEST(TrackerTest, AnObjectOnARectangleCreatedFromTheSameScanStartsNoTrack) {
+  for (const int threads : {1, 2}) {
+    TrackerParams params;
+    params.compute.threads = threads;
+    Tracker tracker(params);
+    tracker.SetRecordEvidence(true);
+    constexpr std::int64_t kT = 1'700'000'000'000'000;
+    std::vector<ScanOutput> out;
+    for (std::int64_t t = kT - 50'000; t <= kT + 200'000; t += 10'000) tracker.AddPose({t, Eigen::Isometry3d::Identity()}, &out);
+    LadarScan scan;
+    scan.utime = kT;
+    scan.sweep_duration_us = 100'000;
+    scan.num_rings = 1;
+    const auto add = [&](double x, double y) {
+      scan.x.push_back(static_cast<float>(x));
+      scan.y.push_back(static_cast<float>(y));
+      scan.z.push_back(0.0f);
+      scan.intensity.push_back(0.0f);
+      scan.dt_us.push_back(static_cast<std::int32_t>(scan.x.size()));
+      scan.ring.push_back(0);
+    };
+    // The corner at (10, -0.9): the rear face along y to (10, 0.9), the side along x to (14.4, -0.9).
+    for (int i = 0; i < 20; ++i) add(10.0, 0.9 - 1.8 * i / 19.0);
+    for (int i = 1; i <= 20; ++i) add(10.0 + 4.4 * i / 20.0, -0.9);
+    // Inside the car's rectangle, 2 m behind its rear face.
+    for (int i = 0; i < 6; ++i) add(12.0 + 0.05 * i, 0.2 + 0.04 * i);
+    tracker.AddScan(std::move(scan), &out);
+    tracker.Flush(&out);
+    std::string rejects;
+    for (const auto& [reason, n] : tracker.rejects()) rejects += reason + " " + std::to_string(n) + "; ";
+    ASSERT_EQ(out.size(), 1u) << threads << " threads; refused: " << rejects;
+    EXPECT_EQ(out[0].tracks.size(), 1u) << threads << " threads";
+    EXPECT_EQ(out[0].evidence.size(), 1u) << threads << " threads: a track was started on the cluster";
+  }
+}
+
 // ScanOutput::stages: each stage's time is the difference of the caller's clock between its end
 // and the one before (a clock that advances by a stage's own number of seconds at each reading
 // gives every stage that number, in the pipeline's order); without a clock nothing is measured,

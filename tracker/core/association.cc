@@ -142,14 +142,15 @@ double Associator::PairCost(const PredictedObject& t, double margin, std::uint8_
   // min_inside_fraction, evaluated as below); once more returns than n - need lie outside, the
   // part is no candidate whatever the rest, and the loop stops (large segments, facades, overlap
   // the gates of many tracks with few of their returns inside).
+  const BoxFrame frame(t.box);
+  const RectFrame box{frame.c.x(), frame.c.y(), frame.ax, frame.ay, 0.5 * t.box.length,
+                      0.5 * t.box.width};
+  if (internal::BoxOutsideGate(box, margin, part.min, part.max)) return kInf;
   const double nd = static_cast<double>(n);
   std::size_t need = static_cast<std::size_t>(std::max(1.0, std::ceil(params_.min_inside_fraction * nd)));
   while (need > 1 && static_cast<double>(need - 1) / nd >= params_.min_inside_fraction) --need;
   while (need <= n && static_cast<double>(need) / nd < params_.min_inside_fraction) ++need;
   if (need > n) return kInf;
-  const BoxFrame frame(t.box);
-  const RectFrame box{frame.c.x(), frame.c.y(), frame.ax, frame.ay, 0.5 * t.box.length,
-                      0.5 * t.box.width};
   const internal::GateSums sums = internal::SumGate(box, margin, visible, n - need,
                                                     part.points.data(), n, pts.x.data(),
                                                     pts.y.data());
@@ -189,27 +190,24 @@ void Associator::IndexClaimingGates(const std::vector<PredictedObject>& tracks) 
   sorted_.Build(lo, hi, established);
 }
 
-void Associator::ClaimingTracks(const Segment& s, const WorldPoints& pts,
-                                const Segments& segments, Scratch* scratch) const {
+void Associator::ClaimingTracks(const Segment& s, Scratch* scratch) const {
   // Established tracks with at least split_min_points of this segment's returns inside their
   // gate, in track order.
   std::vector<std::size_t>& claim = scratch->claim;
   claim.clear();
   sorted_.Overlapping(s.min, s.max, &scratch->candidates);
-  const std::int32_t* const point = segments.point.data();
+  const auto n = static_cast<std::size_t>(s.end - s.begin);
   for (const std::int32_t jj : scratch->candidates) {
     const auto j = static_cast<std::size_t>(jj);
     // Counted up to split_min_points (all the claim needs).
-    const int inside = internal::CountInside(gates_[j], point + s.begin,
-                                             static_cast<std::size_t>(s.end - s.begin),
-                                             pts.x.data(), pts.y.data(), params_.split_min_points);
+    const int inside = internal::CountInside(gates_[j], n, scratch->seg_x.data(),
+                                             scratch->seg_y.data(), params_.split_min_points);
     if (inside >= params_.split_min_points) claim.push_back(j);
   }
 }
 
-void Associator::SplitAmong(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
-                            const std::int32_t* begin, const std::int32_t* end, Scratch* scratch,
-                            Part* parts) const {
+void Associator::SplitAmong(const std::vector<PredictedObject>& tracks, const std::int32_t* begin,
+                            const std::int32_t* end, Scratch* scratch, Part* parts) const {
   // Each return goes to the claimant it is nearest to, ordered by the signed distance to the
   // rectangle boundary (> 0 outside, <= 0 inside): the distance inside, its square outside.
   // Most segments of a KITTI scan are claimed by two or more tracks (clutter tracks on
@@ -221,49 +219,31 @@ void Associator::SplitAmong(const std::vector<PredictedObject>& tracks, const Wo
     claimants.push_back({g.cx, g.cy, g.ax, g.ay, 0.5 * tracks[j].box.length,
                          0.5 * tracks[j].box.width});
   }
-  // Claimant by claimant over the returns gathered side by side (an odd count padded with a
-  // copy of the last return, whose answer is not used): each return still meets the claimants
-  // in order and keeps the first of the nearest.
+  // Claimant by claimant over the segment's returns side by side (its padding's answer is not
+  // used): each return still meets the claimants in order and keeps the first of the nearest.
   const auto n = static_cast<std::size_t>(end - begin);
   const std::size_t padded = n + (n & 1);
-  std::vector<double>& x = scratch->split_x;
-  std::vector<double>& y = scratch->split_y;
-  x.resize(padded);
-  y.resize(padded);
   scratch->split_d.assign(padded, kInf);
   scratch->split_best.assign(padded, 0);
-  for (std::size_t k = 0; k < n; ++k) {
-    x[k] = pts.x[static_cast<std::size_t>(begin[k])];
-    y[k] = pts.y[static_cast<std::size_t>(begin[k])];
-  }
-  if (padded > n) {
-    x[n] = x[n - 1];
-    y[n] = y[n - 1];
-  }
   for (std::size_t c = 0; c < claimants.size(); ++c) {
-    internal::KeepNearer(claimants[c], static_cast<std::int64_t>(c), padded, x.data(), y.data(),
-                         scratch->split_d.data(), scratch->split_best.data());
+    internal::KeepNearer(claimants[c], static_cast<std::int64_t>(c), padded,
+                         scratch->seg_x.data(), scratch->seg_y.data(), scratch->split_d.data(),
+                         scratch->split_best.data());
   }
   for (std::size_t k = 0; k < n; ++k) {
     parts[static_cast<std::size_t>(scratch->split_best[k])].points.push_back(begin[k]);
   }
 }
 
-std::size_t Associator::BoundParts(const WorldPoints& pts, std::size_t first, std::size_t end,
-                                   bool split, std::vector<Part>* parts) const {
-  // Bounding boxes; drops pieces of a split that are too small to fit (their buffers are kept
-  // for reuse: swapped, not moved, to the end). Returns the new end of the parts in use.
+std::size_t Associator::BoundSplit(const WorldPoints& pts, std::size_t first, std::size_t end,
+                                   std::vector<Part>* parts) const {
+  // Bounding boxes; drops pieces that are too small to fit (their buffers are kept for reuse:
+  // swapped, not moved, to the end). Returns the new end of the parts in use.
   std::size_t w = first;
   for (std::size_t q = first; q < end; ++q) {
     Part& part = (*parts)[q];
-    if (split && static_cast<int>(part.points.size()) < params_.split_min_points) continue;
-    part.min = Eigen::Vector2d::Constant(kInf);
-    part.max = -part.min;
-    for (const std::int32_t i : part.points) {
-      const Eigen::Vector2d p(pts.x[static_cast<std::size_t>(i)], pts.y[static_cast<std::size_t>(i)]);
-      part.min = part.min.cwiseMin(p);
-      part.max = part.max.cwiseMax(p);
-    }
+    if (static_cast<int>(part.points.size()) < params_.split_min_points) continue;
+    Bound(part.points.size(), pts.x.data(), pts.y.data(), part.points.data(), &part);
     if (w != q) {
       std::swap((*parts)[w].points, part.points);
       (*parts)[w].min = part.min;
@@ -281,19 +261,34 @@ std::size_t Associator::PartsOf(const std::vector<PredictedObject>& tracks, cons
   std::size_t used = 0;
   for (std::size_t k = seg_begin; k < seg_end; ++k) {
     const Segment& s = segments.segments[k];
-    ClaimingTracks(s, pts, segments, scratch);
+    // The segment's returns gathered side by side once, for the claims and the split.
+    const std::int32_t* seg_begin_point = segments.point.data() + s.begin;
+    const std::int32_t* seg_end_point = segments.point.data() + s.end;
+    const auto n = static_cast<std::size_t>(s.end - s.begin);
+    scratch->seg_x.resize(n + (n & 1));
+    scratch->seg_y.resize(n + (n & 1));
+    for (std::size_t r = 0; r < n; ++r) {
+      scratch->seg_x[r] = pts.x[static_cast<std::size_t>(seg_begin_point[r])];
+      scratch->seg_y[r] = pts.y[static_cast<std::size_t>(seg_begin_point[r])];
+    }
+    if ((n & 1) != 0) {
+      scratch->seg_x[n] = scratch->seg_x[n - 1];
+      scratch->seg_y[n] = scratch->seg_y[n - 1];
+    }
+    ClaimingTracks(s, scratch);
     const std::size_t first = used;
     const std::size_t num_parts = scratch->claim.size() >= 2 ? scratch->claim.size() : 1;
     if (parts->size() < first + num_parts) parts->resize(first + num_parts);
     for (std::size_t q = first; q < first + num_parts; ++q) (*parts)[q].points.clear();
-    const std::int32_t* seg_begin_point = segments.point.data() + s.begin;
-    const std::int32_t* seg_end_point = segments.point.data() + s.end;
     if (num_parts == 1) {
-      (*parts)[first].points.assign(seg_begin_point, seg_end_point);
+      Part& part = (*parts)[first];
+      part.points.assign(seg_begin_point, seg_end_point);
+      Bound(n, scratch->seg_x.data(), scratch->seg_y.data(), nullptr, &part);
+      used = first + 1;
     } else {
-      SplitAmong(tracks, pts, seg_begin_point, seg_end_point, scratch, parts->data() + first);
+      SplitAmong(tracks, seg_begin_point, seg_end_point, scratch, parts->data() + first);
+      used = BoundSplit(pts, first, first + num_parts, parts);
     }
-    used = BoundParts(pts, first, first + num_parts, num_parts > 1, parts);
   }
   return used;
 }

@@ -35,6 +35,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -135,7 +136,8 @@ class Associator {
     std::vector<std::int32_t> candidates;  // gates (or parts) overlapping a box
     std::vector<std::size_t> claim;        // the tracks claiming one segment
     std::vector<RectFrame> claimants;      // their rectangles
-    std::vector<double> split_x, split_y;  // split: the segment's returns side by side
+    // The segment's returns side by side (an odd count padded with a copy of the last).
+    ReturnArray<double> seg_x, seg_y;
     std::vector<double> split_d;           // split: per return, its distance to the nearest claimant
     std::vector<std::int64_t> split_best;  // split: per return, that claimant
   };
@@ -145,15 +147,29 @@ class Associator {
   std::size_t PartsOf(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
                       const Segments& segments, std::size_t seg_begin, std::size_t seg_end,
                       Scratch* scratch, std::vector<Part>* parts) const;
-  void ClaimingTracks(const Segment& s, const WorldPoints& pts, const Segments& segments,
-                      Scratch* scratch) const;
-  void SplitAmong(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
-                  const std::int32_t* begin, const std::int32_t* end, Scratch* scratch,
-                  Part* parts) const;
-  // Bounding boxes of parts [first, end); drops pieces of a split too small to fit. Returns the
-  // new end.
-  std::size_t BoundParts(const WorldPoints& pts, std::size_t first, std::size_t end, bool split,
+  // The established tracks whose gates hold split_min_points of segment s's returns
+  // (scratch->seg_x, seg_y), into scratch->claim.
+  void ClaimingTracks(const Segment& s, Scratch* scratch) const;
+  // The segment's returns [begin, end) (scratch->seg_x, seg_y) among the claimants, into
+  // parts[0, claimants).
+  void SplitAmong(const std::vector<PredictedObject>& tracks, const std::int32_t* begin,
+                  const std::int32_t* end, Scratch* scratch, Part* parts) const;
+  // Bounding boxes of the pieces [first, end) of a split; drops those too small to fit. Returns
+  // the new end.
+  std::size_t BoundSplit(const WorldPoints& pts, std::size_t first, std::size_t end,
                          std::vector<Part>* parts) const;
+  // part's bounding box: of (x[k], y[k]), k < n, or of (x[idx[k]], y[idx[k]]) if idx is given.
+  static void Bound(std::size_t n, const double* x, const double* y, const std::int32_t* idx,
+                    Part* part) {
+    part->min = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+    part->max = -part->min;
+    for (std::size_t k = 0; k < n; ++k) {
+      const auto i = idx != nullptr ? static_cast<std::size_t>(idx[k]) : k;
+      const Eigen::Vector2d p(x[i], y[i]);
+      part->min = part->min.cwiseMin(p);
+      part->max = part->max.cwiseMax(p);
+    }
+  }
   // Candidate pairs with their costs, in (track, part) order.
   void CandidatePairs(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
                       const Eigen::Vector2d& sensor_xy, std::vector<Pair>* pairs);

@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -46,10 +47,21 @@ inline GateSums SumGate(const Associator::RectFrame& box, double margin, std::ui
                  std::size_t max_outside, const std::int32_t* idx, std::size_t n,
                  const double* x, const double* y);
 
-// The returns (x[idx[k]], y[idx[k]]), k < n, inside the rectangle gate (|qx| <= hl and
-// |qy| <= hw in its frame), counted in order up to limit (the count stops there).
-inline int CountInside(const Associator::RectFrame& gate, const std::int32_t* idx, std::size_t n,
-                const double* x, const double* y, int limit);
+// True if the axis-aligned box [lo, hi] lies wholly outside the gate (box's rectangle grown by
+// margin) along one of the gate's axes: then SumGate finds every return in it outside, and its
+// only answer is the early stop. The projections of a point in [lo, hi] lie between those of
+// the box's corners; each computed projection is within a few ulps of (|dx| + |dy|) of the
+// exact one (dx, dy: the offsets from the gate's centre), so a slack of 1e-12 times the
+// corners' largest |dx| + |dy| keeps the test on the safe side of any return's rounding: a box
+// it calls outside holds no return that SumGate would count inside.
+inline bool BoxOutsideGate(const Associator::RectFrame& box, double margin,
+                           const Eigen::Vector2d& lo, const Eigen::Vector2d& hi);
+
+// The returns (x[k], y[k]), k < n (an odd count padded with one more, whose answer is not
+// used), inside the rectangle gate (|qx| <= hl and |qy| <= hw in its frame), counted in order up to limit (the
+// count stops there).
+inline int CountInside(const Associator::RectFrame& gate, std::size_t n, const double* x,
+                       const double* y, int limit);
 
 // For returns (x[k], y[k]), k < n (even), the signed distance d to the boundary of rectangle f
 // (> 0 outside: the squared distance; <= 0 inside: minus the distance to the nearest side),
@@ -150,18 +162,37 @@ inline GateSums SumGate(const Associator::RectFrame& box, double margin, std::ui
   return sums;
 }
 
-inline int CountInside(const Associator::RectFrame& gate, const std::int32_t* idx, std::size_t n,
-                const double* x, const double* y, int limit) {
+inline bool BoxOutsideGate(const Associator::RectFrame& box, double margin,
+                           const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  double u_lo = kInf, u_hi = -kInf, v_lo = kInf, v_hi = -kInf, reach = 0.0;
+  for (const double x : {lo.x(), hi.x()}) {
+    for (const double y : {lo.y(), hi.y()}) {
+      const double dx = x - box.cx, dy = y - box.cy;
+      const double u = dx * box.ax + dy * box.ay, v = -dx * box.ay + dy * box.ax;
+      u_lo = std::min(u_lo, u);
+      u_hi = std::max(u_hi, u);
+      v_lo = std::min(v_lo, v);
+      v_hi = std::max(v_hi, v);
+      reach = std::max(reach, std::abs(dx) + std::abs(dy));
+    }
+  }
+  const double slack = 1e-12 * reach;
+  const double gate_l = box.hl + margin, gate_w = box.hw + margin;
+  return u_lo - slack > gate_l || u_hi + slack < -gate_l || v_lo - slack > gate_w ||
+         v_hi + slack < -gate_w;
+}
+
+inline int CountInside(const Associator::RectFrame& gate, std::size_t n, const double* x,
+                       const double* y, int limit) {
   const Double2 cx = Splat(gate.cx), cy = Splat(gate.cy), ax = Splat(gate.ax), ay = Splat(gate.ay);
   const Double2 hl = Splat(gate.hl), hw = Splat(gate.hw);
-  // Two returns per step (an odd last one twice, its second lane unused): lane by lane the
-  // frame's doubles, counted lane by lane up to limit.
+  // Two returns per step (the padding in the second lane of an odd last step, unused): lane by
+  // lane the frame's doubles, counted lane by lane up to limit.
   int inside = 0;
   for (std::size_t k = 0; k < n && inside < limit; k += 2) {
-    const auto i0 = static_cast<std::size_t>(idx[k]);
-    const auto i1 = static_cast<std::size_t>(idx[k + 1 < n ? k + 1 : k]);
-    const Double2 dx = Double2{x[i0], x[i1]} - cx;
-    const Double2 dy = Double2{y[i0], y[i1]} - cy;
+    const Double2 dx = Load2(x + k) - cx;
+    const Double2 dy = Load2(y + k) - cy;
     const Mask2 in = (Abs2(dx * ax + dy * ay) <= hl) & (Abs2(-dx * ay + dy * ax) <= hw);
     inside += in[0] ? 1 : 0;
     if (k + 1 < n && inside < limit) inside += in[1] ? 1 : 0;

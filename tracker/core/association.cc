@@ -138,14 +138,16 @@ double Associator::PairCost(const PredictedObject& t, double margin, std::uint8_
   *inside_fraction = 0.0;
   const std::size_t n = part.points.size();
   if (n == 0) return kInf;
+  const BoxFrame frame(t.box);
+  const RectFrame box{frame.c.x(), frame.c.y(), frame.ax, frame.ay, 0.5 * t.box.length,
+                      0.5 * t.box.width};
+  // A part beside the gate, though within its bounds along the world's axes (a long facade
+  // passing a gate at an angle): every return outside, as the loop below would find.
+  if (internal::BoxOutsideGate(box, margin, part.min, part.max)) return kInf;
   // The fewest returns inside the gate for a candidate (inside >= 1 and inside / n >=
   // min_inside_fraction, evaluated as below); once more returns than n - need lie outside, the
   // part is no candidate whatever the rest, and the loop stops (large segments, facades, overlap
   // the gates of many tracks with few of their returns inside).
-  const BoxFrame frame(t.box);
-  const RectFrame box{frame.c.x(), frame.c.y(), frame.ax, frame.ay, 0.5 * t.box.length,
-                      0.5 * t.box.width};
-  if (internal::BoxOutsideGate(box, margin, part.min, part.max)) return kInf;
   const double nd = static_cast<double>(n);
   std::size_t need = static_cast<std::size_t>(std::max(1.0, std::ceil(params_.min_inside_fraction * nd)));
   while (need > 1 && static_cast<double>(need - 1) / nd >= params_.min_inside_fraction) --need;

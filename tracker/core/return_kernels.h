@@ -1,9 +1,10 @@
 // The per-return loops of association (association.cc) and RANSAC (fitting.cc) that run two
 // returns per step (double2.h). Each lane performs the operations of the one-return-at-a-time
 // code, and counts, early exits and sums go return by return in the original order, so every
-// result is bit for bit what a loop over one return at a time gives (no decision changes).
-// Internal to vtrack_core (compiled without floating-point contraction, like its callers); in a
-// header of their own so that a test can hold them against a scalar loop.
+// result is bit for bit what a loop over one return at a time gives (no decision changes). With
+// them, the test that spares the pair cost's loop where its answer is known from a bounding box
+// (BoxOutsideGate). Internal to vtrack_core (compiled without floating-point contraction, like
+// its callers); in a header of their own so that a test can hold them against scalar loops.
 #pragma once
 
 #include <Eigen/Core>
@@ -48,18 +49,17 @@ inline GateSums SumGate(const Associator::RectFrame& box, double margin, std::ui
                  const double* x, const double* y);
 
 // True if the axis-aligned box [lo, hi] lies wholly outside the gate (box's rectangle grown by
-// margin) along one of the gate's axes: then SumGate finds every return in it outside, and its
-// only answer is the early stop. The projections of a point in [lo, hi] lie between those of
-// the box's corners; each computed projection is within a few ulps of (|dx| + |dy|) of the
-// exact one (dx, dy: the offsets from the gate's centre), so a slack of 1e-12 times the
-// corners' largest |dx| + |dy| keeps the test on the safe side of any return's rounding: a box
-// it calls outside holds no return that SumGate would count inside.
+// margin) along one of the gate's axes: then SumGate finds every return in [lo, hi] outside.
+// Exact, not merely conservative: each operation of a return's projection (as SumGate computes
+// it: x - cx, times ax or ay, the sum) rounds to nearest, which is monotonic, so the computed
+// projection is monotonic in x and in y, and over the box it lies between the computed
+// projections of the box's corners. False where a corner's projection is not finite.
 inline bool BoxOutsideGate(const Associator::RectFrame& box, double margin,
                            const Eigen::Vector2d& lo, const Eigen::Vector2d& hi);
 
 // The returns (x[k], y[k]), k < n (an odd count padded with one more, whose answer is not
-// used), inside the rectangle gate (|qx| <= hl and |qy| <= hw in its frame), counted in order up to limit (the
-// count stops there).
+// used), inside the rectangle gate (|qx| <= hl and |qy| <= hw in its frame), counted in order up
+// to limit (the count stops there).
 inline int CountInside(const Associator::RectFrame& gate, std::size_t n, const double* x,
                        const double* y, int limit);
 
@@ -165,22 +165,21 @@ inline GateSums SumGate(const Associator::RectFrame& box, double margin, std::ui
 inline bool BoxOutsideGate(const Associator::RectFrame& box, double margin,
                            const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  double u_lo = kInf, u_hi = -kInf, v_lo = kInf, v_hi = -kInf, reach = 0.0;
+  double u_lo = kInf, u_hi = -kInf, v_lo = kInf, v_hi = -kInf;
+  bool finite = true;
   for (const double x : {lo.x(), hi.x()}) {
     for (const double y : {lo.y(), hi.y()}) {
       const double dx = x - box.cx, dy = y - box.cy;
       const double u = dx * box.ax + dy * box.ay, v = -dx * box.ay + dy * box.ax;
+      finite = finite && std::isfinite(u) && std::isfinite(v);
       u_lo = std::min(u_lo, u);
       u_hi = std::max(u_hi, u);
       v_lo = std::min(v_lo, v);
       v_hi = std::max(v_hi, v);
-      reach = std::max(reach, std::abs(dx) + std::abs(dy));
     }
   }
-  const double slack = 1e-12 * reach;
-  const double gate_l = box.hl + margin, gate_w = box.hw + margin;
-  return u_lo - slack > gate_l || u_hi + slack < -gate_l || v_lo - slack > gate_w ||
-         v_hi + slack < -gate_w;
+  const double gate_l = box.hl + margin, gate_w = box.hw + margin;  // as SumGate's
+  return finite && (u_lo > gate_l || u_hi < -gate_l || v_lo > gate_w || v_hi < -gate_w);
 }
 
 inline int CountInside(const Associator::RectFrame& gate, std::size_t n, const double* x,

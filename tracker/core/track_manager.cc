@@ -54,6 +54,11 @@ TrackManager::TrackManager(const TrackManagerParams& params, const Ekf& ekf,
   std::string error;
   if (!params_.Validate(&error)) throw std::invalid_argument(error);
   if (!shape_params_.Validate(&error)) throw std::invalid_argument(error);
+  first_hypothesis_.shape = ShapeEstimator(shape_params_);
+  first_hypothesis_.inside_fraction =
+      params_.mode == TrackerMode::kVasm && !params_.vasm_variants.empty()
+          ? params_.vasm_variants[0].inside_fraction
+          : params_.ism_inside_fraction;
 }
 
 bool TrackManager::Parked(const Track& t) const {
@@ -134,8 +139,7 @@ void TrackManager::GrowIntoRectangle(const PointSet& points, const Eigen::Vector
   // vehicle's rectangle (the default dimensions), not the small object's: which face a single
   // edge is (side or end) is judged against the default width.
   TrackHypothesis& h0 = t->hyps[0];
-  TrackHypothesis fresh;
-  fresh.shape = ShapeEstimator(shape_params_);
+  TrackHypothesis fresh = FirstHypothesis();
   fresh.inside_fraction = h0.inside_fraction;
   fresh.noise_scale = h0.noise_scale;
   CentreMeasurement m;
@@ -374,14 +378,7 @@ bool TrackManager::CreateFromBox(const BoxMeasurement& b, const DetectionParams&
   return true;
 }
 
-TrackHypothesis TrackManager::FirstHypothesis() const {
-  TrackHypothesis h;
-  h.shape = ShapeEstimator(shape_params_);
-  h.inside_fraction = params_.mode == TrackerMode::kVasm && !params_.vasm_variants.empty()
-                          ? params_.vasm_variants[0].inside_fraction
-                          : params_.ism_inside_fraction;
-  return h;
-}
+TrackHypothesis TrackManager::FirstHypothesis() const { return first_hypothesis_; }
 
 void TrackManager::StartFilter(const CentreMeasurement& m, TrackHypothesis* h) const {
   h->filter = ekf_.Convert(ekf_.InitIsm(m), FirstModel(params_.mode), 0.0);

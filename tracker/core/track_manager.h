@@ -246,6 +246,9 @@ class TrackManager {
   const Ekf& ekf_;
   TrackMeasurer measurer_;
   ShapeParams shape_params_;
+  // What FirstHypothesis copies: built once, as each new object's shape histograms would be
+  // built alike (their bins zeroed, the same smoothing kernel).
+  TrackHypothesis first_hypothesis_;
   MoverTest mover_test_;
   std::vector<Track> tracks_;
   std::int64_t next_id_ = 1;

@@ -421,6 +421,18 @@ TEST(TrackerLiveTest, KittiFusedPlayedLiveGivesTheSameTracksAsOffline) {
   std::filesystem::remove(log);
 }
 
+// The sweeps a driver says it published ("stopped: N scans published, K skipped"), or -1.
+long long PublishedScans(const std::string& driver_output) {
+  const std::string key = "stopped: ";
+  const std::size_t at = driver_output.rfind(key);
+  long long published = -1;
+  if (at == std::string::npos ||
+      std::sscanf(driver_output.c_str() + at + key.size(), "%lld scans published", &published) != 1) {
+    return -1;
+  }
+  return published;
+}
+
 // The KITTI fused demo on the bus: vtrack-ladar-driver replays KITTI 0000's sweeps (as slices),
 // ground truth and PointRCNN boxes, vtrack-ego-pose its poses, and a live tracker in fused mode
 // tracks them while lcm-logger records everything. The recorded inputs tracked offline give the
@@ -463,14 +475,19 @@ TEST(TrackerLiveTest, KittiFusedDemoLiveGivesTheOfflineTracks) {
       slices += ev->channel == "LADAR_SLICE";
     }
   }
-  EXPECT_EQ(detection_lists, 154);
-  EXPECT_GT(slices, 154 * 10);
+  // A driver starved of CPU for over 0.5 s skips the overdue sweeps (sensor_driver/README.md),
+  // as a loaded 2-core machine may make it: each sweep it published is on the bus and tracked.
+  const long long published = PublishedScans(ReadFile(dir + "/driver.txt"));
+  EXPECT_GE(published, 154 * 9 / 10) << ReadFile(dir + "/driver.txt");
+  EXPECT_LE(published, 154);
+  EXPECT_EQ(detection_lists, published);
+  EXPECT_GT(slices, published * 10);
   ASSERT_EQ(RunCommand({Bin("vtrack-tracker"), "--input", live, "--output", offline,
                         "--input-mode", "fused", "-q"}, dir + "/offline.txt"), 0)
       << ReadFile(dir + "/offline.txt");
-  EXPECT_GE(CompareTracks(TracksByUtime(live), TracksByUtime(offline), 1e-9), 150);
+  EXPECT_GE(CompareTracks(TracksByUtime(live), TracksByUtime(offline), 1e-9), published - 4);
   const tracker_status_t st = LastStatus(live);
-  EXPECT_EQ(st.scans_processed, 154);
+  EXPECT_EQ(st.scans_processed, published);
   std::filesystem::remove(live);
   std::filesystem::remove(offline);
 }

@@ -50,6 +50,15 @@ LadarScan ScanFromLcm(ladar_scan_t&& msg) {
   return s;
 }
 
+void LendArrays(LadarScan&& spare, ladar_scan_t* msg) {
+  msg->x = std::move(spare.x);
+  msg->y = std::move(spare.y);
+  msg->z = std::move(spare.z);
+  msg->intensity = std::move(spare.intensity);
+  msg->dt_us = std::move(spare.dt_us);
+  msg->ring = std::move(spare.ring);
+}
+
 LadarScan ScanFromLcm(lcm_util::AssembledSweep&& sweep) {
   LadarScan s = ScanFromLcm(std::move(sweep.scan));
   for (const lcm_util::AzimuthArc& a : sweep.missing) s.lost_wedges.push_back({a.begin, a.end});

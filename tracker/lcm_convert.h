@@ -17,6 +17,10 @@ namespace vtrack {
 
 // Moves the point arrays out of msg (no copy); msg's arrays are left empty.
 LadarScan ScanFromLcm(ladar_scan_t&& msg);
+// Gives msg the point arrays of a scan the tracker is done with (Tracker::TakeSpareScan), so that
+// decoding into msg (lcm_util::Decode, which resizes each array to npoints and overwrites it)
+// reuses their memory.
+void LendArrays(LadarScan&& spare, ladar_scan_t* msg);
 // A sweep assembled from slices: its scan moved out, its missing arcs as the lost wedges.
 LadarScan ScanFromLcm(lcm_util::AssembledSweep&& sweep);
 // A quaternion within 1e-3 of unit length is normalised; others are passed on as they are and

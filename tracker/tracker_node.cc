@@ -75,6 +75,7 @@ void TrackerNode::Handle(const std::string& channel, const void* data, std::size
   try {
     if (channel == options_.scan_channel) {
       ladar_scan_t msg;
+      LendArrays(tracker_.TakeSpareScan(), &msg);
       if (!DecodeOrCount(channel, data, size, &msg)) return;
       returns_received_ += msg.npoints;
       NoteArrival(msg.utime);

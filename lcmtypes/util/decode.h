@@ -12,6 +12,12 @@
 #include <new>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
+
+namespace vtrack {
+class ladar_scan_t;
+class ladar_slice_t;
+}  // namespace vtrack
 
 namespace vtrack::lcm_util {
 
@@ -35,6 +41,14 @@ std::int64_t ReadFingerprint(const void* data, std::size_t size);
 // than the buffer could possibly carry. Unknown fingerprints pass (the type check catches them).
 bool CheckLengths(std::int64_t fingerprint, const void* data, std::size_t size, std::string* why);
 
+// Decodes the two point-cloud types, whose fingerprint the caller has checked, from
+// data[0, size) into *out, array by array (point_cloud_decode.cc says why): the same fields as
+// LCM's generated decode(), bit for bit, and the same return (bytes read, or -1 if the buffer
+// ends early). Unlike it, every array is resized to npoints, also to 0; arrays already in *out
+// lend their memory (a whole sweep decoded into the arrays of the one before allocates nothing).
+int DecodePointCloud(const void* data, std::size_t size, ladar_scan_t* out);
+int DecodePointCloud(const void* data, std::size_t size, ladar_slice_t* out);
+
 // Decodes a T from data[0, size). Never throws.
 template <class T>
 DecodeError Decode(const void* data, std::size_t size, T* out, std::string* why = nullptr) {
@@ -45,7 +59,12 @@ DecodeError Decode(const void* data, std::size_t size, T* out, std::string* why 
   if (!CheckLengths(fp, data, size, why ? why : &local_why)) return DecodeError::kBadLength;
   if (size > static_cast<std::size_t>(INT32_MAX)) return DecodeError::kMalformed;
   try {
-    const int n = out->decode(data, 0, static_cast<int>(size));
+    int n = -1;
+    if constexpr (std::is_same_v<T, ladar_scan_t> || std::is_same_v<T, ladar_slice_t>) {
+      n = DecodePointCloud(data, size, out);
+    } else {
+      n = out->decode(data, 0, static_cast<int>(size));
+    }
     if (n < 0) return DecodeError::kMalformed;
   } catch (const std::bad_alloc&) {
     return DecodeError::kBadLength;

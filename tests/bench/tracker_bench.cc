@@ -22,6 +22,11 @@
 // seg_ms - assoc_ms (the last three and the sequencing around the pipeline).
 //  - BM_CopyFloor_Kitti: the physical floor, a plain copy of each scan's point arrays (x, y, z,
 //    intensity, dt_us, ring) into buffers allocated once.
+//  - BM_DecodeSweep_Kitti/0 and /1: decoding each KITTI scan's ladar_scan_t (2.2-2.7 MB) as
+//    vtrack-tracker does when it arrives whole, into the core's LadarScan: /0 into fresh arrays,
+//    /1 into the arrays of the scan decoded before (LendArrays, as the tracker lends those of the
+//    scan it is done with, Tracker::TakeSpareScan). CPU time of the thread, which counts the page
+//    faults of fresh memory.
 //  - BM_PointsScaling/N: KITTI frames resampled to N = 10k..1M returns per scan (every k-th return
 //    below the native count; above it, each return repeated with a seeded 2 cm jitter: a denser
 //    sensor seeing the same scene).
@@ -45,7 +50,9 @@
 #include <thread>
 #include <vector>
 
+#include "lcmtypes/util/decode.h"
 #include "tests/bench/bench_data.h"
+#include "tests/support/encode.h"
 #include "base/angle.h"
 
 namespace {
@@ -229,6 +236,65 @@ void BM_CopyFloor_Kitti(benchmark::State& state) {
   state.SetBytesProcessed(static_cast<std::int64_t>(bytes));
 }
 BENCHMARK(BM_CopyFloor_Kitti)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(400);
+
+// Each scan encoded as the LCM message a sensor sends (mounting left at identity: decoding does
+// not depend on it).
+std::vector<std::vector<std::uint8_t>> EncodedScans(const Sequence& seq) {
+  std::vector<std::vector<std::uint8_t>> out;
+  for (const LadarScan& s : seq.scans) {
+    ladar_scan_t m{};
+    m.utime = s.utime;
+    m.seq = s.seq;
+    m.sensor_id = s.sensor_id;
+    m.sensor_orientation[0] = 1.0;
+    m.sweep_duration_us = s.sweep_duration_us;
+    m.max_range = s.max_range;
+    m.num_rings = s.num_rings;
+    m.npoints = static_cast<std::int32_t>(s.size());
+    m.x = s.x;
+    m.y = s.y;
+    m.z = s.z;
+    m.intensity = s.intensity;
+    m.dt_us = s.dt_us;
+    m.ring = s.ring;
+    out.push_back(testing::Encode(m));
+  }
+  return out;
+}
+
+void BM_DecodeSweep_Kitti(benchmark::State& state) {
+  const Sequence& seq = bench::Kitti();
+  if (!seq.error.empty()) {
+    state.SkipWithError(seq.error.c_str());
+    return;
+  }
+  const bool lend = state.range(0) != 0;
+  const auto encoded = EncodedScans(seq);
+  LadarScan held;
+  std::size_t i = 0;
+  std::vector<double> ms;
+  for (auto _ : state) {
+    const std::vector<std::uint8_t>& b = encoded[i];
+    const double c0 = ThreadCpuSeconds();
+    ladar_scan_t msg;
+    if (lend) {
+      LendArrays(std::move(held), &msg);
+    }
+    if (lcm_util::Decode(b.data(), b.size(), &msg) != lcm_util::DecodeError::kNone) {
+      state.SkipWithError("a scan did not decode");
+      return;
+    }
+    held = ScanFromLcm(std::move(msg));
+    benchmark::ClobberMemory();
+    const double c1 = ThreadCpuSeconds();
+    state.SetIterationTime(c1 - c0);
+    ms.push_back(1e3 * (c1 - c0));
+    i = (i + 1) % encoded.size();
+  }
+  state.counters["median_ms"] = bench::Percentile(ms, 50);
+  state.counters["p99_ms"] = bench::Percentile(ms, 99);
+}
+BENCHMARK(BM_DecodeSweep_Kitti)->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(400);
 
 // KITTI frames 1..20 resampled to n returns per scan (one size cached at a time).
 const Sequence& Resampled(std::size_t n) {

@@ -346,7 +346,14 @@ const LadarScan* ScanSequencer::Ready(bool flush, bool* extrapolate) const {
 void ScanSequencer::Done(bool processed) {
   if (processed) ++scans_processed_;
   else ++scans_dropped_;
+  spare_ = std::move(queue_.front());
   queue_.pop_front();
+}
+
+LadarScan ScanSequencer::TakeSpare() {
+  LadarScan s = std::move(spare_);
+  spare_ = LadarScan();
+  return s;
 }
 
 }  // namespace vtrack

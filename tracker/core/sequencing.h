@@ -99,8 +99,14 @@ class ScanSequencer {
   // The oldest queued scan if it may be processed now (flush: whatever the poses), else
   // nullptr. *extrapolate: the pose stream has not reached the scan's end.
   const LadarScan* Ready(bool flush, bool* extrapolate) const;
-  // Removes the scan Ready() gave, counting it processed or dropped.
+  // Removes the scan Ready() gave, counting it processed or dropped. Its arrays are kept for
+  // TakeSpare().
   void Done(bool processed);
+  // The scan Done() removed last (an empty scan if there is none, or it was taken), to decode the
+  // next sweep into: its arrays still hold its returns, and a decoder that overwrites them
+  // (lcm_util::DecodePointCloud) allocates and zeroes nothing for a sweep of no more returns (a
+  // 64-beam sweep is 2.7 MB, whose fresh pages cost about as much as decoding it).
+  LadarScan TakeSpare();
   // The same for detection lists.
   const DetectionList* ReadyDetections(bool flush, bool* extrapolate) const;
   void DoneDetections(bool processed);
@@ -135,6 +141,7 @@ class ScanSequencer {
   RejectCounter* rejects_;
   PoseHistory poses_;
   std::deque<LadarScan> queue_;
+  LadarScan spare_;
   std::deque<DetectionList> detections_;
   std::int64_t last_detections_utime_ = 0;
   bool have_detections_ = false;

@@ -99,6 +99,9 @@ class Tracker {
   // A detector's boxes (used in the input modes boxes and fused, ignored with scans only).
   void AddDetections(DetectionList&& list, std::vector<ScanOutput>* out);
   void Flush(std::vector<ScanOutput>* out);
+  // The latest scan the tracker is done with, its arrays to decode the next one into
+  // (ScanSequencer::TakeSpare).
+  LadarScan TakeSpareScan() { return sequencer_.TakeSpare(); }
 
   // Counters since construction.
   std::int64_t scans_received() const { return sequencer_.scans_received(); }

@@ -1,0 +1,191 @@
+// The point-cloud decoder (lcmtypes/util/point_cloud_decode.cc) against LCM's generated decode():
+// the same fields bit for bit, and the same messages accepted and refused, on seeded random
+// messages (any float bit pattern: NaNs with payloads, infinities, subnormals, -0), their
+// truncations and corruptions, and into messages already holding other returns.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "lcmtypes/util/decode.h"
+#include "tests/support/encode.h"
+#include "vtrack/ladar_scan_t.hpp"
+#include "vtrack/ladar_slice_t.hpp"
+
+namespace vtrack::testing {
+namespace {
+
+using lcm_util::Decode;
+using lcm_util::DecodeError;
+
+template <class T>
+bool SameBits(const T& a, const T& b) {
+  return std::memcmp(&a, &b, sizeof(T)) == 0;
+}
+
+template <class T>
+::testing::AssertionResult SameArray(const char* name, const std::vector<T>& a,
+                                     const std::vector<T>& b) {
+  if (a.size() != b.size()) {
+    return ::testing::AssertionFailure() << name << ": " << a.size() << " against " << b.size()
+                                         << " elements";
+  }
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (!SameBits(a[i], b[i])) return ::testing::AssertionFailure() << name << "[" << i << "] differs";
+  }
+  return ::testing::AssertionSuccess();
+}
+
+// Every field of two messages of the same type, floats compared as bits.
+template <class Msg>
+::testing::AssertionResult SameFields(const Msg& a, const Msg& b) {
+  if (a.utime != b.utime || a.seq != b.seq || a.sensor_id != b.sensor_id ||
+      a.sweep_duration_us != b.sweep_duration_us || a.num_rings != b.num_rings ||
+      a.npoints != b.npoints || !SameBits(a.max_range, b.max_range) ||
+      std::memcmp(a.sensor_pos, b.sensor_pos, sizeof a.sensor_pos) != 0 ||
+      std::memcmp(a.sensor_orientation, b.sensor_orientation, sizeof a.sensor_orientation) != 0) {
+    return ::testing::AssertionFailure() << "a header field differs";
+  }
+  if constexpr (std::is_same_v<Msg, ladar_slice_t>) {
+    if (a.slice_index != b.slice_index || a.slice_count != b.slice_count ||
+        !SameBits(a.azimuth_begin, b.azimuth_begin) || !SameBits(a.azimuth_end, b.azimuth_end)) {
+      return ::testing::AssertionFailure() << "a slice field differs";
+    }
+  }
+  for (auto r : {SameArray("x", a.x, b.x), SameArray("y", a.y, b.y), SameArray("z", a.z, b.z),
+                 SameArray("intensity", a.intensity, b.intensity),
+                 SameArray("dt_us", a.dt_us, b.dt_us), SameArray("ring", a.ring, b.ring)}) {
+    if (!r) return r;
+  }
+  return ::testing::AssertionSuccess();
+}
+
+// Messages whose every number is a random bit pattern.
+class RandomClouds {
+ public:
+  explicit RandomClouds(unsigned seed) : rng_(seed) {}
+
+  template <class T>
+  T Bits() {
+    std::uint64_t u = rng_();
+    T v;
+    std::memcpy(&v, &u, sizeof v);
+    return v;
+  }
+
+  template <class Msg>
+  Msg Make(int npoints) {
+    Msg m{};
+    m.utime = Bits<std::int64_t>();
+    m.seq = Bits<std::int64_t>();
+    const int len = static_cast<int>(rng_() % 40);
+    for (int i = 0; i < len; ++i) m.sensor_id += static_cast<char>(1 + rng_() % 255);  // no NUL
+    for (double& v : m.sensor_pos) v = Bits<double>();
+    for (double& v : m.sensor_orientation) v = Bits<double>();
+    m.sweep_duration_us = Bits<std::int32_t>();
+    m.max_range = Bits<float>();
+    m.num_rings = Bits<std::int16_t>();
+    if constexpr (std::is_same_v<Msg, ladar_slice_t>) {
+      m.slice_index = Bits<std::int32_t>();
+      m.slice_count = Bits<std::int32_t>();
+      m.azimuth_begin = Bits<double>();
+      m.azimuth_end = Bits<double>();
+    }
+    m.npoints = npoints;
+    auto fill = [&](auto* v) {
+      v->resize(static_cast<std::size_t>(npoints));
+      for (auto& e : *v) e = Bits<std::decay_t<decltype(e)>>();
+    };
+    fill(&m.x);
+    fill(&m.y);
+    fill(&m.z);
+    fill(&m.intensity);
+    fill(&m.dt_us);
+    fill(&m.ring);
+    return m;
+  }
+
+  int Count(int hi) { return static_cast<int>(rng_() % static_cast<unsigned>(hi + 1)); }
+  std::mt19937_64& rng() { return rng_; }
+
+ private:
+  std::mt19937_64 rng_;
+};
+
+template <class Msg>
+class PointCloudDecodeTest : public ::testing::Test {};
+using CloudTypes = ::testing::Types<ladar_scan_t, ladar_slice_t>;
+TYPED_TEST_SUITE(PointCloudDecodeTest, CloudTypes);
+
+TYPED_TEST(PointCloudDecodeTest, DecodesEveryFieldAsTheGeneratedDecoder) {
+  RandomClouds r(11);
+  for (int k = 0; k < 300; ++k) {
+    const int n = k < 5 ? k : r.Count(k % 7 == 0 ? 5000 : 300);
+    const std::vector<std::uint8_t> bytes = Encode(r.Make<TypeParam>(n));
+    TypeParam reference;
+    ASSERT_EQ(reference.decode(bytes.data(), 0, static_cast<int>(bytes.size())),
+              static_cast<int>(bytes.size()));
+    TypeParam fresh;
+    ASSERT_EQ(Decode(bytes.data(), bytes.size(), &fresh), DecodeError::kNone) << k;
+    EXPECT_TRUE(SameFields(fresh, reference)) << "message " << k << ", " << n << " returns";
+    // Into a message holding other returns, more or fewer: none of them may survive.
+    TypeParam reused = r.Make<TypeParam>(r.Count(2 * n + 3));
+    ASSERT_EQ(Decode(bytes.data(), bytes.size(), &reused), DecodeError::kNone) << k;
+    EXPECT_TRUE(SameFields(reused, reference)) << "message " << k << " decoded into another";
+  }
+}
+
+TYPED_TEST(PointCloudDecodeTest, ReturnsTheBytesReadAndRefusesEveryTruncation) {
+  RandomClouds r(12);
+  const std::vector<std::uint8_t> bytes = Encode(r.Make<TypeParam>(9));
+  TypeParam m;
+  EXPECT_EQ(lcm_util::DecodePointCloud(bytes.data(), bytes.size(), &m),
+            static_cast<int>(bytes.size()));
+  for (std::size_t cut = 0; cut < bytes.size(); ++cut) {
+    TypeParam reference, fast;
+    ASSERT_EQ(reference.decode(bytes.data(), 0, static_cast<int>(cut)), -1) << cut;
+    EXPECT_EQ(lcm_util::DecodePointCloud(bytes.data(), cut, &fast), -1) << "cut at " << cut;
+    EXPECT_NE(Decode(bytes.data(), cut, &fast), DecodeError::kNone) << "cut at " << cut;
+  }
+}
+
+// Corrupted bytes: Decode accepts exactly what the length walk and the generated decoder accept,
+// with the same fields.
+TYPED_TEST(PointCloudDecodeTest, AcceptsAndRefusesCorruptionsAsTheGeneratedDecoder) {
+  RandomClouds r(13);
+  int accepted = 0, refused = 0;
+  for (int k = 0; k < 3000; ++k) {
+    std::vector<std::uint8_t> bytes = Encode(r.Make<TypeParam>(r.Count(6)));
+    const int flips = 1 + r.Count(3);
+    for (int f = 0; f < flips; ++f) {
+      // Mostly the header (lengths, the string), where a flip changes the layout.
+      const std::size_t at = 8 + r.rng()() % std::min<std::size_t>(bytes.size() - 8, 120);
+      bytes[at] ^= static_cast<std::uint8_t>(1u << (r.rng()() % 8));
+    }
+    std::string why;
+    const bool layout_ok =
+        lcm_util::CheckLengths(TypeParam::getHash(), bytes.data(), bytes.size(), &why);
+    TypeParam reference;
+    const bool reference_ok =
+        layout_ok && reference.decode(bytes.data(), 0, static_cast<int>(bytes.size())) ==
+                         static_cast<int>(bytes.size());
+    TypeParam fast = r.Make<TypeParam>(3);
+    const bool fast_ok = Decode(bytes.data(), bytes.size(), &fast) == DecodeError::kNone;
+    ASSERT_EQ(fast_ok, reference_ok) << "corruption " << k << ": " << why;
+    if (fast_ok) {
+      ++accepted;
+      EXPECT_TRUE(SameFields(fast, reference)) << "corruption " << k;
+    } else {
+      ++refused;
+    }
+  }
+  // Both outcomes exercised (a flip in a number is accepted, one in a length refused).
+  EXPECT_GT(accepted, 300);
+  EXPECT_GT(refused, 300);
+}
+
+}  // namespace
+}  // namespace vtrack::testing

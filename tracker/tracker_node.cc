@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "lcmtypes/util/decode.h"
+#include "lcmtypes/util/encode.h"
 #include "tracker/lcm_convert.h"
 #include "vtrack/ladar_scan_t.hpp"
 #include "vtrack/ladar_slice_t.hpp"
@@ -156,15 +157,13 @@ void TrackerNode::Emit(std::vector<ScanOutput>* outs) {
     latencies_ms_.push_back(last_latency_ms_);
     if (latencies_ms_.size() > 100) latencies_ms_.pop_front();
     const track_list_t msg = TrackListToLcm(o, mode, latency_us);
-    buffer_.resize(static_cast<std::size_t>(msg.getEncodedSize()));
-    msg.encode(buffer_.data(), 0, static_cast<int>(buffer_.size()));
+    lcm_util::Encode(msg, &buffer_);
     publish_(o.utime, options_.tracks_channel, buffer_.data(), buffer_.size());
     ++tracks_published_;
     if (evidence_csv_.is_open()) WriteEvidence(o);
     if (options_.debug) {
       const track_debug_t dbg = DebugToLcm(o);
-      buffer_.resize(static_cast<std::size_t>(dbg.getEncodedSize()));
-      dbg.encode(buffer_.data(), 0, static_cast<int>(buffer_.size()));
+      lcm_util::Encode(dbg, &buffer_);
       publish_(o.utime, options_.debug_channel, buffer_.data(), buffer_.size());
     }
     last_tentative_ = last_confirmed_ = last_coasting_ = 0;
@@ -216,8 +215,7 @@ tracker_status_t TrackerNode::Status() const {
 
 void TrackerNode::PublishStatus(std::int64_t event_utime) {
   const tracker_status_t s = Status();
-  buffer_.resize(static_cast<std::size_t>(s.getEncodedSize()));
-  s.encode(buffer_.data(), 0, static_cast<int>(buffer_.size()));
+  lcm_util::Encode(s, &buffer_);
   publish_(event_utime, options_.status_channel, buffer_.data(), buffer_.size());
 }
 

@@ -42,7 +42,7 @@ std::int64_t ReadFingerprint(const void* data, std::size_t size);
 bool CheckLengths(std::int64_t fingerprint, const void* data, std::size_t size, std::string* why);
 
 // Decodes the two point-cloud types, whose fingerprint the caller has checked, from
-// data[0, size) into *out, array by array (point_cloud_decode.cc says why): the same fields as
+// data[0, size) into *out, array by array (point_cloud_codec.cc says why): the same fields as
 // LCM's generated decode(), bit for bit, and the same return (bytes read, or -1 if the buffer
 // ends early). Unlike it, every array is resized to npoints, also to 0; arrays already in *out
 // lend their memory (a whole sweep decoded into the arrays of the one before allocates nothing).

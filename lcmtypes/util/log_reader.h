@@ -6,8 +6,11 @@
 #include <cstdint>
 #include <cstdio>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "lcmtypes/util/encode.h"
 
 namespace vtrack::lcm_util {
 
@@ -73,12 +76,16 @@ class LogWriter {
   explicit LogWriter(const std::string& path);
   void Write(std::int64_t timestamp_us, const std::string& channel, const void* data,
              std::size_t size);
+  // Throws std::invalid_argument if msg cannot be encoded (encode.h: a point cloud whose arrays
+  // do not hold npoints elements).
   template <class Msg>
   void WriteMessage(std::int64_t timestamp_us, const std::string& channel, const Msg& msg) {
-    const int n = msg.getEncodedSize();
-    buffer_.resize(static_cast<std::size_t>(n));
-    msg.encode(buffer_.data(), 0, n);
-    Write(timestamp_us, channel, buffer_.data(), buffer_.size());
+    const int n = Encode(msg, &buffer_);
+    if (n < 0) {
+      throw std::invalid_argument(std::string("cannot encode a ") + Msg::getTypeName() + " for " +
+                                  channel + " in " + path_);
+    }
+    Write(timestamp_us, channel, buffer_.data(), static_cast<std::size_t>(n));
   }
   std::int64_t events_written() const { return next_event_; }
 
@@ -86,7 +93,7 @@ class LogWriter {
   std::string path_;
   std::unique_ptr<lcm::LogFile> log_;
   std::int64_t next_event_ = 0;
-  std::string buffer_;
+  std::vector<std::uint8_t> buffer_;
 };
 
 }  // namespace vtrack::lcm_util

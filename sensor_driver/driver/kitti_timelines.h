@@ -11,7 +11,9 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include <memory>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "lcmtypes/util/process.h"
 #include "sensor_driver/driver/realtime.h"
@@ -58,6 +60,7 @@ class KittiScanTimeline : public KittiTimeline {
 
  private:
   SweepOutput output_;
+  std::vector<std::uint8_t> buffer_;  // a sweep's encoding, kept from sweep to sweep
   std::string truth_channel_;
   std::string detections_channel_;
   vtrack::ladar_scan_t scan_;

@@ -1,5 +1,7 @@
 #include "sensor_driver/driver/timelines.h"
 
+#include "lcmtypes/util/encode.h"
+
 namespace vtrack::sim {
 
 SimScanTimeline::SimScanTimeline(Simulator* sim, lcm::LCM* lcm, SweepOutput output,
@@ -13,7 +15,7 @@ void SimScanTimeline::Prepare(int i, std::int64_t lap_start_utime, std::int64_t 
 
 void SimScanTimeline::Publish() {
   slices_ += SendSweep(output_, scan_, [&](const std::string& ch, const auto& msg) {
-    if (lcm_->publish(ch, &msg) < 0) log_.Warn("publish", "publishing " + ch + " failed");
+    if (lcm_util::Publish(lcm_, ch, msg, &buffer_) < 0) log_.Warn("publish", "publishing " + ch + " failed");
   }, /*paced=*/true);
   points_ += scan_.npoints;
   if (!truth_channel_.empty() && lcm_->publish(truth_channel_, &truth_) < 0) {

@@ -4,7 +4,9 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "lcmtypes/util/process.h"
 #include "sensor_driver/driver/realtime.h"
@@ -30,6 +32,7 @@ class SimScanTimeline : public Timeline {
   Simulator* sim_;
   lcm::LCM* lcm_;
   SweepOutput output_;
+  std::vector<std::uint8_t> buffer_;  // a sweep's encoding, kept from sweep to sweep
   std::string truth_channel_;
   vtrack::ladar_scan_t scan_;
   vtrack::object_list_t truth_;

@@ -11,8 +11,9 @@
 //                  slices in one burst after the sweep, kSliceGapUs apart.)
 // The latency runs from the publication of the last return (the whole scan, or the last slice).
 // The poses through each scan's last return time are published before the scan (as on a vehicle,
-// where the pose source runs ahead of the sweep), so the latency is decoding + tracking +
-// encoding + the bus, not waiting for poses. The first --warmup scans are not counted.
+// where the pose source runs ahead of the sweep), so the latency is the sweep's encoding (as
+// vtrack-ladar-driver encodes it, lcm_util::Publish) + the bus + decoding + tracking + encoding
+// the tracks + the bus, not waiting for poses. The first --warmup scans are not counted.
 //
 // udpm only inside a private loopback-only network namespace (scripts/vtrack-netns); elsewhere
 // it exits 77 (skipped). Wall-clock times (steady clock) of this process.
@@ -35,6 +36,7 @@
 #include <string>
 #include <vector>
 
+#include "lcmtypes/util/encode.h"
 #include "lcmtypes/util/ladar_slices.h"
 #include "lcmtypes/util/process.h"
 #include "sensor_driver/kitti/kitti_sequence.h"
@@ -213,6 +215,7 @@ int main(int argc, char** argv) {
   const std::int64_t seq_span = frames.back().utime + period_us - first;
   std::int64_t next_pose = seq->FirstPoseUtime() + 10'000;
   std::map<std::int64_t, Clock::time_point> published;
+  std::vector<std::uint8_t> cloud_buffer;  // encoded as vtrack-ladar-driver does (encode.h)
   std::vector<std::int64_t> counted;
   long sliced_scans = 0, slices_sent = 0;
   auto tick = Clock::now();
@@ -233,7 +236,7 @@ int main(int argc, char** argv) {
     std::vector<vtrack::ladar_slice_t>& slices = frame_slices[f];
     if (slices.empty()) {
       published[scan.utime] = Clock::now();
-      lcm.publish("LADAR_SCAN", &scan);
+      vtrack::lcm_util::Publish(&lcm, "LADAR_SCAN", scan, &cloud_buffer);
     } else {
       // Each slice when its last return is measured, from the scan's start (this tick); TRACKS
       // of the scan before are taken in the gaps.
@@ -242,7 +245,7 @@ int main(int argc, char** argv) {
         slice.utime = scan.utime;
         slice.seq = k;
         published[scan.utime] = Clock::now();
-        lcm.publish("LADAR_SLICE", &slice);
+        vtrack::lcm_util::Publish(&lcm, "LADAR_SLICE", slice, &cloud_buffer);
         slice.utime = orig_utime;
       }
       sliced_scans += 1;

@@ -27,6 +27,9 @@
 //    /1 into the arrays of the scan decoded before (LendArrays, as the tracker lends those of the
 //    scan it is done with, Tracker::TakeSpareScan). CPU time of the thread, which counts the page
 //    faults of fresh memory.
+//  - BM_EncodeSweep_Kitti/0 and /1: encoding each KITTI scan as a sensor driver publishes it: /0
+//    as lcm::LCM::publish(channel, &msg) does (the generated encoder, into a buffer allocated per
+//    message), /1 as vtrack-ladar-driver does (lcm_util::Encode into a buffer kept between sweeps).
 //  - BM_PointsScaling/N: KITTI frames resampled to N = 10k..1M returns per scan (every k-th return
 //    below the native count; above it, each return repeated with a seeded 2 cm jitter: a denser
 //    sensor seeing the same scene).
@@ -51,6 +54,7 @@
 #include <vector>
 
 #include "lcmtypes/util/decode.h"
+#include "lcmtypes/util/encode.h"
 #include "tests/bench/bench_data.h"
 #include "tests/support/encode.h"
 #include "base/angle.h"
@@ -237,10 +241,10 @@ void BM_CopyFloor_Kitti(benchmark::State& state) {
 }
 BENCHMARK(BM_CopyFloor_Kitti)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(400);
 
-// Each scan encoded as the LCM message a sensor sends (mounting left at identity: decoding does
-// not depend on it).
-std::vector<std::vector<std::uint8_t>> EncodedScans(const Sequence& seq) {
-  std::vector<std::vector<std::uint8_t>> out;
+// Each scan as the LCM message a sensor sends (mounting left at identity: coding does not depend
+// on it).
+std::vector<ladar_scan_t> ScanMessages(const Sequence& seq) {
+  std::vector<ladar_scan_t> out;
   for (const LadarScan& s : seq.scans) {
     ladar_scan_t m{};
     m.utime = s.utime;
@@ -257,8 +261,14 @@ std::vector<std::vector<std::uint8_t>> EncodedScans(const Sequence& seq) {
     m.intensity = s.intensity;
     m.dt_us = s.dt_us;
     m.ring = s.ring;
-    out.push_back(testing::Encode(m));
+    out.push_back(std::move(m));
   }
+  return out;
+}
+
+std::vector<std::vector<std::uint8_t>> EncodedScans(const Sequence& seq) {
+  std::vector<std::vector<std::uint8_t>> out;
+  for (const ladar_scan_t& m : ScanMessages(seq)) out.push_back(testing::Encode(m));
   return out;
 }
 
@@ -295,6 +305,45 @@ void BM_DecodeSweep_Kitti(benchmark::State& state) {
   state.counters["p99_ms"] = bench::Percentile(ms, 99);
 }
 BENCHMARK(BM_DecodeSweep_Kitti)->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(400);
+
+void BM_EncodeSweep_Kitti(benchmark::State& state) {
+  const Sequence& seq = bench::Kitti();
+  if (!seq.error.empty()) {
+    state.SkipWithError(seq.error.c_str());
+    return;
+  }
+  const bool kept_buffer = state.range(0) != 0;
+  const std::vector<ladar_scan_t> messages = ScanMessages(seq);
+  std::vector<std::uint8_t> buffer;
+  std::size_t i = 0;
+  std::vector<double> ms;
+  for (auto _ : state) {
+    const ladar_scan_t& m = messages[i];
+    const double c0 = ThreadCpuSeconds();
+    int n = -1;
+    if (kept_buffer) {
+      n = lcm_util::Encode(m, &buffer);
+    } else {
+      // What lcm::LCM::publish(channel, &msg) does before sending.
+      const int size = m.getEncodedSize();
+      std::unique_ptr<std::uint8_t[]> fresh(new std::uint8_t[static_cast<std::size_t>(size)]);
+      n = m.encode(fresh.get(), 0, size);
+      benchmark::DoNotOptimize(fresh.get());
+    }
+    benchmark::ClobberMemory();
+    const double c1 = ThreadCpuSeconds();
+    if (n < 0) {
+      state.SkipWithError("a scan did not encode");
+      return;
+    }
+    state.SetIterationTime(c1 - c0);
+    ms.push_back(1e3 * (c1 - c0));
+    i = (i + 1) % messages.size();
+  }
+  state.counters["median_ms"] = bench::Percentile(ms, 50);
+  state.counters["p99_ms"] = bench::Percentile(ms, 99);
+}
+BENCHMARK(BM_EncodeSweep_Kitti)->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(400);
 
 // KITTI frames 1..20 resampled to n returns per scan (one size cached at a time).
 const Sequence& Resampled(std::size_t n) {

@@ -1,7 +1,8 @@
-// The point-cloud decoder (lcmtypes/util/point_cloud_decode.cc) against LCM's generated decode():
-// the same fields bit for bit, and the same messages accepted and refused, on seeded random
-// messages (any float bit pattern: NaNs with payloads, infinities, subnormals, -0), their
-// truncations and corruptions, and into messages already holding other returns.
+// The point-cloud codec (lcmtypes/util/point_cloud_codec.cc) against LCM's generated code:
+// decoded, the same fields bit for bit and the same messages accepted and refused; encoded, the
+// same bytes; on seeded random messages (any float bit pattern: NaNs with payloads, infinities,
+// subnormals, -0), their truncations and corruptions, into messages and buffers already holding
+// others, and over an in-process LCM bus.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -10,7 +11,10 @@
 #include <string>
 #include <vector>
 
+#include <lcm/lcm-cpp.hpp>
+
 #include "lcmtypes/util/decode.h"
+#include "lcmtypes/util/encode.h"
 #include "tests/support/encode.h"
 #include "vtrack/ladar_scan_t.hpp"
 #include "vtrack/ladar_slice_t.hpp"
@@ -116,11 +120,11 @@ class RandomClouds {
 };
 
 template <class Msg>
-class PointCloudDecodeTest : public ::testing::Test {};
+class PointCloudCodecTest : public ::testing::Test {};
 using CloudTypes = ::testing::Types<ladar_scan_t, ladar_slice_t>;
-TYPED_TEST_SUITE(PointCloudDecodeTest, CloudTypes);
+TYPED_TEST_SUITE(PointCloudCodecTest, CloudTypes);
 
-TYPED_TEST(PointCloudDecodeTest, DecodesEveryFieldAsTheGeneratedDecoder) {
+TYPED_TEST(PointCloudCodecTest, DecodesEveryFieldAsTheGeneratedDecoder) {
   RandomClouds r(11);
   for (int k = 0; k < 300; ++k) {
     const int n = k < 5 ? k : r.Count(k % 7 == 0 ? 5000 : 300);
@@ -138,7 +142,7 @@ TYPED_TEST(PointCloudDecodeTest, DecodesEveryFieldAsTheGeneratedDecoder) {
   }
 }
 
-TYPED_TEST(PointCloudDecodeTest, ReturnsTheBytesReadAndRefusesEveryTruncation) {
+TYPED_TEST(PointCloudCodecTest, ReturnsTheBytesReadAndRefusesEveryTruncation) {
   RandomClouds r(12);
   const std::vector<std::uint8_t> bytes = Encode(r.Make<TypeParam>(9));
   TypeParam m;
@@ -154,7 +158,7 @@ TYPED_TEST(PointCloudDecodeTest, ReturnsTheBytesReadAndRefusesEveryTruncation) {
 
 // Corrupted bytes: Decode accepts exactly what the length walk and the generated decoder accept,
 // with the same fields.
-TYPED_TEST(PointCloudDecodeTest, AcceptsAndRefusesCorruptionsAsTheGeneratedDecoder) {
+TYPED_TEST(PointCloudCodecTest, AcceptsAndRefusesCorruptionsAsTheGeneratedDecoder) {
   RandomClouds r(13);
   int accepted = 0, refused = 0;
   for (int k = 0; k < 3000; ++k) {
@@ -185,6 +189,71 @@ TYPED_TEST(PointCloudDecodeTest, AcceptsAndRefusesCorruptionsAsTheGeneratedDecod
   // Both outcomes exercised (a flip in a number is accepted, one in a length refused).
   EXPECT_GT(accepted, 300);
   EXPECT_GT(refused, 300);
+}
+
+TYPED_TEST(PointCloudCodecTest, EncodesTheBytesOfTheGeneratedEncoder) {
+  RandomClouds r(14);
+  std::vector<std::uint8_t> buffer;
+  for (int k = 0; k < 300; ++k) {
+    const int n = k < 5 ? k : r.Count(k % 7 == 0 ? 5000 : 300);
+    const TypeParam m = r.Make<TypeParam>(n);
+    const std::vector<std::uint8_t> reference = Encode(m);
+    // The buffer holds the message before, longer or shorter: its bytes must not survive.
+    ASSERT_EQ(lcm_util::Encode(m, &buffer), static_cast<int>(reference.size())) << k;
+    ASSERT_EQ(buffer, reference) << "message " << k << ", " << n << " returns";
+  }
+}
+
+TYPED_TEST(PointCloudCodecTest, RefusesToEncodeAnInconsistentMessage) {
+  RandomClouds r(15);
+  std::vector<std::uint8_t> buffer;
+  const TypeParam good = r.Make<TypeParam>(7);
+  ASSERT_EQ(lcm_util::Encode(good, &buffer), static_cast<int>(Encode(good).size()));
+  TypeParam short_ring = good;
+  short_ring.ring.pop_back();
+  EXPECT_EQ(lcm_util::Encode(short_ring, &buffer), -1);
+  TypeParam long_x = good;
+  long_x.x.push_back(1.0f);
+  EXPECT_EQ(lcm_util::Encode(long_x, &buffer), -1);
+  // The same number of bytes in all, but not npoints in each array.
+  TypeParam shifted = good;
+  shifted.x.push_back(1.0f);
+  shifted.y.pop_back();
+  EXPECT_EQ(lcm_util::Encode(shifted, &buffer), -1);
+  TypeParam negative = good;
+  negative.npoints = -1;
+  EXPECT_EQ(lcm_util::Encode(negative, &buffer), -1);
+  // LCM's encoder would write the name up to the NUL but announce its whole size.
+  TypeParam nul = good;
+  nul.sensor_id = std::string("velo\0dyne", 9);
+  EXPECT_EQ(lcm_util::Encode(nul, &buffer), -1);
+}
+
+TYPED_TEST(PointCloudCodecTest, PublishesTheBytesOfTheGeneratedEncoderOnTheBus) {
+  lcm::LCM bus("memq://");
+  ASSERT_TRUE(bus.good());
+  std::vector<std::vector<std::uint8_t>> received;
+  struct Sink {
+    std::vector<std::vector<std::uint8_t>>* out;
+    void On(const lcm::ReceiveBuffer* rb, const std::string&) {
+      const auto* b = static_cast<const std::uint8_t*>(rb->data);
+      out->emplace_back(b, b + rb->data_size);
+    }
+  } sink{&received};
+  bus.subscribe("CLOUD", &Sink::On, &sink);
+  RandomClouds r(16);
+  std::vector<TypeParam> sent;
+  std::vector<std::uint8_t> buffer;
+  for (int k = 0; k < 5; ++k) {
+    sent.push_back(r.Make<TypeParam>(r.Count(2000)));
+    ASSERT_EQ(lcm_util::Publish(&bus, "CLOUD", sent.back(), &buffer), 0);
+    ASSERT_EQ(bus.handleTimeout(1000), 1);
+  }
+  ASSERT_EQ(received.size(), sent.size());
+  for (std::size_t k = 0; k < sent.size(); ++k) EXPECT_EQ(received[k], Encode(sent[k])) << k;
+  TypeParam bad = sent[0];
+  bad.z.clear();
+  EXPECT_EQ(lcm_util::Publish(&bus, "CLOUD", bad, &buffer), -1);
 }
 
 }  // namespace

@@ -12,12 +12,8 @@
 #include <new>
 #include <stdexcept>
 #include <string>
-#include <type_traits>
 
-namespace vtrack {
-class ladar_scan_t;
-class ladar_slice_t;
-}  // namespace vtrack
+#include "lcmtypes/util/point_cloud.h"
 
 namespace vtrack::lcm_util {
 
@@ -60,7 +56,7 @@ DecodeError Decode(const void* data, std::size_t size, T* out, std::string* why 
   if (size > static_cast<std::size_t>(INT32_MAX)) return DecodeError::kMalformed;
   try {
     int n = -1;
-    if constexpr (std::is_same_v<T, ladar_scan_t> || std::is_same_v<T, ladar_slice_t>) {
+    if constexpr (kIsPointCloud<T>) {
       n = DecodePointCloud(data, size, out);
     } else {
       n = out->decode(data, 0, static_cast<int>(size));

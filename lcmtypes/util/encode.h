@@ -10,13 +10,9 @@
 
 #include <cstdint>
 #include <string>
-#include <type_traits>
 #include <vector>
 
-namespace vtrack {
-class ladar_scan_t;
-class ladar_slice_t;
-}  // namespace vtrack
+#include "lcmtypes/util/point_cloud.h"
 
 namespace vtrack::lcm_util {
 
@@ -28,7 +24,7 @@ int EncodePointCloud(const ladar_slice_t& m, std::vector<std::uint8_t>* out);
 // The encoding of any vtrack message into *out: its size, or -1 if the generated encoder fails.
 template <class T>
 int Encode(const T& m, std::vector<std::uint8_t>* out) {
-  if constexpr (std::is_same_v<T, ladar_scan_t> || std::is_same_v<T, ladar_slice_t>) {
+  if constexpr (kIsPointCloud<T>) {
     return EncodePointCloud(m, out);
   } else {
     const int size = m.getEncodedSize();

@@ -33,21 +33,45 @@ using BitsOf = std::conditional_t<
     sizeof(T) == 8, std::uint64_t,
     std::conditional_t<sizeof(T) == 4, std::uint32_t, std::uint16_t>>;
 
-// Reads an LCM body (after the fingerprint) front to back. A read past the end marks the
-// reader failed and leaves the destination as it was.
-class BigEndianReader {
+// A position in a buffer of known size; a step past its end fails it for good.
+class Cursor {
  public:
-  BigEndianReader(const void* data, std::size_t size)
-      : p_(static_cast<const unsigned char*>(data)), size_(size) {}
-
   bool ok() const { return ok_; }
   std::size_t pos() const { return pos_; }
+
+ protected:
+  explicit Cursor(std::size_t size) : size_(size) {}
+
+  // Advances by n bytes, *at their start; false (and failed) if they are not there.
+  bool Take(std::size_t n, std::size_t* at) {
+    if (!ok_ || n > size_ - pos_) {
+      ok_ = false;
+      return false;
+    }
+    *at = pos_;
+    pos_ += n;
+    return true;
+  }
+  void Fail() { ok_ = false; }
+
+ private:
+  std::size_t size_;
+  std::size_t pos_ = 0;
+  bool ok_ = true;
+};
+
+// Reads an LCM body (after the fingerprint) front to back. A read past the end marks the
+// reader failed and leaves the destination as it was.
+class BigEndianReader : public Cursor {
+ public:
+  BigEndianReader(const void* data, std::size_t size)
+      : Cursor(size), p_(static_cast<const unsigned char*>(data)) {}
 
   template <class T>
   void Scalar(T* out) {
     static_assert(std::is_arithmetic_v<T> && sizeof(T) >= 2 && sizeof(T) <= 8);
-    if (!Take(sizeof(T))) return;
-    *out = Load<T>(p_ + pos_ - sizeof(T));
+    std::size_t at = 0;
+    if (Take(sizeof(T), &at)) *out = Load<T>(p_ + at);
   }
 
   template <class T, std::size_t N>
@@ -60,23 +84,24 @@ class BigEndianReader {
   void String(std::string* out) {
     std::int32_t len = 0;
     Scalar(&len);
-    if (!ok_ || len < 1 || !Take(static_cast<std::size_t>(len))) {
-      ok_ = false;
+    std::size_t at = 0;
+    if (!ok() || len < 1 || !Take(static_cast<std::size_t>(len), &at)) {
+      Fail();
       return;
     }
-    out->assign(reinterpret_cast<const char*>(p_ + pos_ - static_cast<std::size_t>(len)),
-                static_cast<std::size_t>(len) - 1);
+    out->assign(reinterpret_cast<const char*>(p_ + at), static_cast<std::size_t>(len) - 1);
   }
 
   // n elements into *out, resized to n (elements already there are overwritten, not zeroed).
   template <class T>
   void Array(std::int32_t n, std::vector<T>* out) {
-    if (n < 0 || !Take(static_cast<std::size_t>(n) * sizeof(T))) {
-      ok_ = false;
+    std::size_t at = 0;
+    if (n < 0 || !Take(static_cast<std::size_t>(n) * sizeof(T), &at)) {
+      Fail();
       return;
     }
     out->resize(static_cast<std::size_t>(n));
-    const unsigned char* src = p_ + pos_ - static_cast<std::size_t>(n) * sizeof(T);
+    const unsigned char* src = p_ + at;
     T* dst = out->data();
     for (std::int32_t i = 0; i < n; ++i) dst[i] = Load<T>(src + static_cast<std::size_t>(i) * sizeof(T));
   }
@@ -92,34 +117,20 @@ class BigEndianReader {
     return v;
   }
 
-  bool Take(std::size_t n) {
-    if (!ok_ || n > size_ - pos_) {
-      ok_ = false;
-      return false;
-    }
-    pos_ += n;
-    return true;
-  }
-
   const unsigned char* p_;
-  std::size_t size_;
-  std::size_t pos_ = 0;
-  bool ok_ = true;
 };
 
 // Writes an LCM encoding into a buffer of the size the message says it needs. A write that
 // would not fit marks the writer failed and writes nothing.
-class BigEndianWriter {
+class BigEndianWriter : public Cursor {
  public:
-  BigEndianWriter(unsigned char* data, std::size_t size) : p_(data), size_(size) {}
-
-  bool ok() const { return ok_; }
-  std::size_t pos() const { return pos_; }
+  BigEndianWriter(unsigned char* data, std::size_t size) : Cursor(size), p_(data) {}
 
   template <class T>
   void Scalar(T v) {
     static_assert(std::is_arithmetic_v<T> && sizeof(T) >= 2 && sizeof(T) <= 8);
-    if (Take(sizeof(T))) Store(v, p_ + pos_ - sizeof(T));
+    std::size_t at = 0;
+    if (Take(sizeof(T), &at)) Store(v, p_ + at);
   }
 
   template <class T, std::size_t N>
@@ -132,8 +143,9 @@ class BigEndianWriter {
   void String(const std::string& s) {
     const std::size_t len = std::strlen(s.c_str());
     Scalar(static_cast<std::int32_t>(len + 1));
-    if (!Take(len + 1)) return;
-    unsigned char* dst = p_ + pos_ - (len + 1);
+    std::size_t at = 0;
+    if (!Take(len + 1, &at)) return;
+    unsigned char* dst = p_ + at;
     std::memcpy(dst, s.data(), len);
     dst[len] = 0;
   }
@@ -143,8 +155,9 @@ class BigEndianWriter {
     // Read through locals: the byte stores may alias any object, v's own pointers included.
     const T* src = v.data();
     const std::size_t n = v.size();
-    if (!Take(n * sizeof(T))) return;
-    unsigned char* dst = p_ + pos_ - n * sizeof(T);
+    std::size_t at = 0;
+    if (!Take(n * sizeof(T), &at)) return;
+    unsigned char* dst = p_ + at;
     for (std::size_t i = 0; i < n; ++i) Store(src[i], dst + i * sizeof(T));
   }
 
@@ -157,19 +170,8 @@ class BigEndianWriter {
     std::memcpy(dst, &bits, sizeof bits);
   }
 
-  bool Take(std::size_t n) {
-    if (!ok_ || n > size_ - pos_) {
-      ok_ = false;
-      return false;
-    }
-    pos_ += n;
-    return true;
-  }
 
   unsigned char* p_;
-  std::size_t size_;
-  std::size_t pos_ = 0;
-  bool ok_ = true;
 };
 
 // The fields both types open with, in their .lcm order.

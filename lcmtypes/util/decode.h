@@ -37,11 +37,14 @@ std::int64_t ReadFingerprint(const void* data, std::size_t size);
 // than the buffer could possibly carry. Unknown fingerprints pass (the type check catches them).
 bool CheckLengths(std::int64_t fingerprint, const void* data, std::size_t size, std::string* why);
 
-// Decodes the two point-cloud types, whose fingerprint the caller has checked, from
-// data[0, size) into *out, array by array (point_cloud_codec.cc says why): the same fields as
-// LCM's generated decode(), bit for bit, and the same return (bytes read, or -1 if the buffer
-// ends early). Unlike it, every array is resized to npoints, also to 0; arrays already in *out
-// lend their memory (a whole sweep decoded into the arrays of the one before allocates nothing).
+// Decodes the two point-cloud types from data[0, size) into *out, array by array
+// (point_cloud_codec.cc says why): the same fields as LCM's generated decode(), bit for bit, and
+// the same return for what it accepts (the bytes read; -1 for another fingerprint or a buffer
+// that ends early). Unlike it, every array is resized to npoints, also to 0, and a string length
+// below 1, a negative npoints or a buffer over INT32_MAX bytes give -1 (where the generated code
+// throws or allocates); arrays already in *out lend their memory (a sweep decoded into the
+// arrays of one at least as large allocates and zeroes nothing). Decode<T> checks the layout
+// (CheckLengths) first.
 int DecodePointCloud(const void* data, std::size_t size, ladar_scan_t* out);
 int DecodePointCloud(const void* data, std::size_t size, ladar_slice_t* out);
 

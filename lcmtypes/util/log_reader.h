@@ -77,7 +77,8 @@ class LogWriter {
   void Write(std::int64_t timestamp_us, const std::string& channel, const void* data,
              std::size_t size);
   // Throws std::invalid_argument if msg cannot be encoded (encode.h: a point cloud whose arrays
-  // do not hold npoints elements).
+  // do not hold npoints elements; a message whose generated encoder writes fewer bytes than it
+  // announces, as with a string holding a NUL).
   template <class Msg>
   void WriteMessage(std::int64_t timestamp_us, const std::string& channel, const Msg& msg) {
     const int n = Encode(msg, &buffer_);

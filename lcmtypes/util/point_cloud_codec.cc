@@ -38,10 +38,22 @@ class Cursor {
  public:
   bool ok() const { return ok_; }
   std::size_t pos() const { return pos_; }
+  void Fail() { ok_ = false; }
 
  protected:
   explicit Cursor(std::size_t size) : size_(size) {}
 
+  // Advances by count elements of elem_bytes each, *at their start; false (and failed) if they
+  // are not there (compared as a count, so that no product can wrap).
+  bool Take(std::size_t count, std::size_t elem_bytes, std::size_t* at) {
+    if (!ok_ || count > (size_ - pos_) / elem_bytes) {
+      ok_ = false;
+      return false;
+    }
+    *at = pos_;
+    pos_ += count * elem_bytes;
+    return true;
+  }
   // Advances by n bytes, *at their start; false (and failed) if they are not there.
   bool Take(std::size_t n, std::size_t* at) {
     if (!ok_ || n > size_ - pos_) {
@@ -52,7 +64,6 @@ class Cursor {
     pos_ += n;
     return true;
   }
-  void Fail() { ok_ = false; }
 
  private:
   std::size_t size_;
@@ -96,7 +107,7 @@ class BigEndianReader : public Cursor {
   template <class T>
   void Array(std::int32_t n, std::vector<T>* out) {
     std::size_t at = 0;
-    if (n < 0 || !Take(static_cast<std::size_t>(n) * sizeof(T), &at)) {
+    if (n < 0 || !Take(static_cast<std::size_t>(n), sizeof(T), &at)) {
       Fail();
       return;
     }
@@ -254,21 +265,29 @@ int Finish(const BigEndianReader& r) {
   return r.ok() ? static_cast<int>(kFingerprintBytes + r.pos()) : -1;
 }
 
+// A reader of the body after Msg's fingerprint, failed if the buffer does not open with it or
+// is longer than an LCM message can be (INT32_MAX bytes, the generated code's int sizes).
+template <class Msg>
+BigEndianReader BodyOf(const void* data, std::size_t size) {
+  const bool fits = size >= kFingerprintBytes && size <= static_cast<std::size_t>(INT32_MAX) &&
+                    ReadFingerprint(data, size) == Msg::getHash();
+  BigEndianReader r(static_cast<const unsigned char*>(data) + (fits ? kFingerprintBytes : 0),
+                    fits ? size - kFingerprintBytes : 0);
+  if (!fits) r.Fail();
+  return r;
+}
+
 }  // namespace
 
 int DecodePointCloud(const void* data, std::size_t size, ladar_scan_t* out) {
-  if (size < kFingerprintBytes) return -1;
-  BigEndianReader r(static_cast<const unsigned char*>(data) + kFingerprintBytes,
-                    size - kFingerprintBytes);
+  BigEndianReader r = BodyOf<ladar_scan_t>(data, size);
   ReadSensor(&r, out);
   ReadReturns(&r, out);
   return Finish(r);
 }
 
 int DecodePointCloud(const void* data, std::size_t size, ladar_slice_t* out) {
-  if (size < kFingerprintBytes) return -1;
-  BigEndianReader r(static_cast<const unsigned char*>(data) + kFingerprintBytes,
-                    size - kFingerprintBytes);
+  BigEndianReader r = BodyOf<ladar_slice_t>(data, size);
   ReadSensor(&r, out);
   r.Scalar(&out->slice_index);
   r.Scalar(&out->slice_count);

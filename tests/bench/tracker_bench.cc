@@ -22,11 +22,12 @@
 // seg_ms - assoc_ms (the last three and the sequencing around the pipeline).
 //  - BM_CopyFloor_Kitti: the physical floor, a plain copy of each scan's point arrays (x, y, z,
 //    intensity, dt_us, ring) into buffers allocated once.
-//  - BM_DecodeSweep_Kitti/0 and /1: decoding each KITTI scan's ladar_scan_t (2.2-2.7 MB) as
-//    vtrack-tracker does when it arrives whole, into the core's LadarScan: /0 into fresh arrays,
-//    /1 into the arrays of the scan decoded before (LendArrays, as the tracker lends those of the
-//    scan it is done with, Tracker::TakeSpareScan). CPU time of the thread, which counts the page
-//    faults of fresh memory.
+//  - BM_DecodeSweep_Kitti/0, /1 and /2: decoding each KITTI scan's ladar_scan_t (2.2-2.7 MB)
+//    into the core's LadarScan: /0 with LCM's generated decode() into fresh arrays, /1 as
+//    lcm_util::Decode does (array by array) into fresh arrays, /2 as vtrack-tracker does when a
+//    sweep arrives whole, lcm_util::Decode into the arrays of the scan decoded before (LendArrays,
+//    as the tracker lends those of the scan it is done with, Tracker::TakeSpareScan). CPU time of
+//    the thread, which counts the page faults of fresh memory.
 //  - BM_EncodeSweep_Kitti/0 and /1: encoding each KITTI scan as a sensor driver publishes it: /0
 //    as lcm::LCM::publish(channel, &msg) does (the generated encoder, into a buffer allocated per
 //    message), /1 as vtrack-ladar-driver does (lcm_util::Encode into a buffer kept between sweeps).
@@ -278,7 +279,8 @@ void BM_DecodeSweep_Kitti(benchmark::State& state) {
     state.SkipWithError(seq.error.c_str());
     return;
   }
-  const bool lend = state.range(0) != 0;
+  const bool generated = state.range(0) == 0;
+  const bool lend = state.range(0) == 2;
   const auto encoded = EncodedScans(seq);
   LadarScan held;
   std::size_t i = 0;
@@ -290,7 +292,11 @@ void BM_DecodeSweep_Kitti(benchmark::State& state) {
     if (lend) {
       LendArrays(std::move(held), &msg);
     }
-    if (lcm_util::Decode(b.data(), b.size(), &msg) != lcm_util::DecodeError::kNone) {
+    const bool ok = generated ? msg.decode(b.data(), 0, static_cast<int>(b.size())) ==
+                                    static_cast<int>(b.size())
+                              : lcm_util::Decode(b.data(), b.size(), &msg) ==
+                                    lcm_util::DecodeError::kNone;
+    if (!ok) {
       state.SkipWithError("a scan did not decode");
       return;
     }
@@ -304,7 +310,7 @@ void BM_DecodeSweep_Kitti(benchmark::State& state) {
   state.counters["median_ms"] = bench::Percentile(ms, 50);
   state.counters["p99_ms"] = bench::Percentile(ms, 99);
 }
-BENCHMARK(BM_DecodeSweep_Kitti)->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(400);
+BENCHMARK(BM_DecodeSweep_Kitti)->Arg(0)->Arg(1)->Arg(2)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(400);
 
 void BM_EncodeSweep_Kitti(benchmark::State& state) {
   const Sequence& seq = bench::Kitti();

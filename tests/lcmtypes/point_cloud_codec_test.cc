@@ -191,6 +191,53 @@ TYPED_TEST(PointCloudCodecTest, AcceptsAndRefusesCorruptionsAsTheGeneratedDecode
   EXPECT_GT(refused, 300);
 }
 
+// Writes v big-endian at byte `at` of an encoding.
+void PutI32(std::vector<std::uint8_t>* b, std::size_t at, std::int32_t v) {
+  const auto u = static_cast<std::uint32_t>(v);
+  for (int i = 0; i < 4; ++i) (*b)[at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(u >> (24 - 8 * i));
+}
+
+// Called directly, without the length walk: a wrong fingerprint, impossible array and string
+// lengths are refused and no array grows past what the buffer holds; an empty cloud empties
+// arrays holding others.
+TYPED_TEST(PointCloudCodecTest, RefusesHostileLengthsWithoutTheLengthWalk) {
+  RandomClouds r(17);
+  const TypeParam m = r.Make<TypeParam>(5);
+  const std::vector<std::uint8_t> good = Encode(m);
+  const std::size_t npoints_at = good.size() - 5 * (4 * 4 + 4 + 2) - 4;
+  const std::size_t string_at = 8 + 8 + 8;
+  for (const std::int32_t n : {-1, INT32_MIN, INT32_MAX, 1 << 30, 6}) {
+    std::vector<std::uint8_t> b = good;
+    PutI32(&b, npoints_at, n);
+    TypeParam out;
+    EXPECT_EQ(lcm_util::DecodePointCloud(b.data(), b.size(), &out), -1) << "npoints " << n;
+    // Arrays are grown only to what the buffer holds.
+    const std::size_t bytes = 4 * (out.x.size() + out.y.size() + out.z.size() + out.intensity.size() +
+                                   out.dt_us.size()) +
+                              2 * out.ring.size();
+    EXPECT_LE(bytes, b.size()) << "npoints " << n;
+  }
+  for (const std::int32_t len : {0, -1, INT32_MIN, INT32_MAX}) {
+    std::vector<std::uint8_t> b = good;
+    PutI32(&b, string_at, len);
+    TypeParam out;
+    EXPECT_EQ(lcm_util::DecodePointCloud(b.data(), b.size(), &out), -1) << "string length " << len;
+  }
+  std::vector<std::uint8_t> other_type = good;
+  other_type[3] ^= 0x10;
+  TypeParam out;
+  EXPECT_EQ(lcm_util::DecodePointCloud(other_type.data(), other_type.size(), &out), -1);
+  // Exactly the encoding: accepted, its size returned.
+  EXPECT_EQ(lcm_util::DecodePointCloud(good.data(), good.size(), &out), static_cast<int>(good.size()));
+  // An empty cloud into arrays holding 40 returns (LCM's decoder would leave them).
+  const std::vector<std::uint8_t> empty = Encode(r.Make<TypeParam>(0));
+  TypeParam full = r.Make<TypeParam>(40);
+  ASSERT_EQ(Decode(empty.data(), empty.size(), &full), DecodeError::kNone);
+  EXPECT_EQ(full.npoints, 0);
+  EXPECT_TRUE(full.x.empty() && full.y.empty() && full.z.empty() && full.intensity.empty() &&
+              full.dt_us.empty() && full.ring.empty());
+}
+
 TYPED_TEST(PointCloudCodecTest, EncodesTheBytesOfTheGeneratedEncoder) {
   RandomClouds r(14);
   std::vector<std::uint8_t> buffer;

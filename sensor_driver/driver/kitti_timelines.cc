@@ -62,7 +62,9 @@ void KittiScanTimeline::Prepare(int i, std::int64_t lap_start_utime, std::int64_
 
 void KittiScanTimeline::Publish() {
   SendSweep(output_, scan_, [&](const std::string& ch, const auto& msg) {
-    if (lcm_util::Publish(lcm(), ch, msg, &buffer_) < 0) log_.Warn("publish", "publishing " + ch + " failed");
+    if (lcm_util::Publish(lcm(), ch, msg, &buffer_) < 0) {
+      log_.Warn("publish", "publishing " + ch + " failed (the bus refused it, or its arrays do not hold npoints)");
+    }
   }, /*paced=*/true);
   if (have_truth_ && lcm()->publish(truth_channel_, &truth_) < 0) {
     log_.Warn("publish_truth", "publishing " + truth_channel_ + " failed");

@@ -10,8 +10,8 @@
 #include <boost/program_options.hpp>
 #include <lcm/lcm-cpp.hpp>
 
-#include <memory>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 

@@ -15,7 +15,9 @@ void SimScanTimeline::Prepare(int i, std::int64_t lap_start_utime, std::int64_t 
 
 void SimScanTimeline::Publish() {
   slices_ += SendSweep(output_, scan_, [&](const std::string& ch, const auto& msg) {
-    if (lcm_util::Publish(lcm_, ch, msg, &buffer_) < 0) log_.Warn("publish", "publishing " + ch + " failed");
+    if (lcm_util::Publish(lcm_, ch, msg, &buffer_) < 0) {
+      log_.Warn("publish", "publishing " + ch + " failed (the bus refused it, or its arrays do not hold npoints)");
+    }
   }, /*paced=*/true);
   points_ += scan_.npoints;
   if (!truth_channel_.empty() && lcm_->publish(truth_channel_, &truth_) < 0) {

@@ -23,6 +23,8 @@
 #include "sensor_driver/driver/sim_cli.h"
 #include "tests/support/encode.h"
 #include "tracker/core/parameters.h"
+#include "tracker/core/tracker.h"
+#include "tracker/lcm_convert.h"
 #include "tracker/tracker_node.h"
 #include "vtrack/ladar_scan_t.hpp"
 #include "vtrack/pose_t.hpp"
@@ -395,6 +397,89 @@ TEST_F(BadInputTest, EveryScanAtTheSameTimeIsCountedOnceByReason) {
   EXPECT_EQ(st.scans_received, sent);
   EXPECT_EQ(SumOfScanReasons(r), st.scans_dropped);
   EXPECT_EQ(st.scans_dropped, sent - st.scans_processed);
+}
+
+// Sweeps shrinking, growing and empty, each decoded by the node into the arrays of the scan
+// before (Tracker::TakeSpareScan): the tracks are those of the core tracker given each scan in
+// arrays of its own (decoded by LCM's generated decoder), and every return processed is counted
+// once.
+TEST_F(BadInputTest, SweepsDecodedIntoTheArraysOfTheOneBeforeGiveTheirOwnTracks) {
+  Injector inj;
+  std::int64_t sent_returns = 0;
+  inj.edit_scan = [&](int i, ladar_scan_t* scan) {
+    // Every 1st, 2nd or 3rd return by turns; no return at all in every 7th sweep.
+    const int step = 1 + i % 3;
+    const auto keep = [&](auto* v) {
+      std::size_t n = 0;
+      for (std::size_t j = 0; j < v->size(); j += static_cast<std::size_t>(step)) (*v)[n++] = (*v)[j];
+      v->resize(i % 7 == 6 ? 0 : n);
+    };
+    keep(&scan->x);
+    keep(&scan->y);
+    keep(&scan->z);
+    keep(&scan->intensity);
+    keep(&scan->dt_us);
+    keep(&scan->ring);
+    scan->npoints = static_cast<std::int32_t>(scan->x.size());
+  };
+  std::unique_ptr<TrackerNode> node;
+  const Output recycled = Run(inj, &node);
+
+  TrackerParams params;
+  params.preprocess.max_points = 5000;
+  Tracker direct(params);
+  Output fresh;
+  std::vector<ScanOutput> outs;
+  const auto take = [&]() {
+    for (const ScanOutput& o : outs) {
+      const track_list_t m = TrackListToLcm(o, ToString(params.manager.mode), 0);
+      fresh.utimes.push_back(m.utime);
+      std::vector<std::uint8_t> bytes;
+      for (const track_t& t : m.tracks) {
+        const auto b = Encode(t);
+        bytes.insert(bytes.end(), b.begin(), b.end());
+      }
+      fresh.tracks.push_back(std::move(bytes));
+      fresh.num_tracks += m.num_tracks;
+    }
+    outs.clear();
+  };
+  const std::int64_t start = sim_->scenario().start_utime;
+  int i = 0, k = 0;
+  ladar_scan_t scan;
+  object_list_t truth;
+  pose_t pose;
+  while (i < sim_->NumScans() || k < sim_->NumPoses()) {
+    if (k < sim_->NumPoses() &&
+        (i >= sim_->NumScans() || sim_->PoseOffsetUs(k) <= sim_->ScanPublishOffsetUs(i))) {
+      sim_->MakePose(k++, start, &pose);
+      direct.AddPose(PoseFromLcm(pose), &outs);
+    } else {
+      sim_->MakeScan(i, start, i, &scan, &truth);
+      inj.edit_scan(i, &scan);
+      sent_returns += scan.npoints;
+      const auto b = Encode(scan);
+      ladar_scan_t own;  // generated decoder, fresh arrays
+      ASSERT_EQ(own.decode(b.data(), 0, static_cast<int>(b.size())), static_cast<int>(b.size()));
+      direct.AddScan(ScanFromLcm(std::move(own)), &outs);
+      ++i;
+    }
+    take();
+  }
+  direct.Flush(&outs);
+  take();
+
+  ASSERT_GT(fresh.tracks.size(), 40u);
+  ASSERT_GT(fresh.num_tracks, 40);
+  EXPECT_EQ(recycled.utimes, fresh.utimes);
+  ASSERT_EQ(recycled.tracks.size(), fresh.tracks.size());
+  for (std::size_t j = 0; j < fresh.tracks.size(); ++j) {
+    EXPECT_EQ(recycled.tracks[j], fresh.tracks[j]) << "TRACKS message " << j;
+  }
+  EXPECT_EQ(node->tracker().returns_processed(), direct.returns_processed());
+  EXPECT_EQ(direct.scans_processed() + direct.scans_dropped(), direct.scans_received());
+  EXPECT_LE(direct.returns_processed(), sent_returns);
+  EXPECT_GT(direct.returns_processed(), sent_returns / 2);
 }
 
 TEST_F(BadInputTest, ScansBeforeAnyPoseAreCountedOnceByReason) {

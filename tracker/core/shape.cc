@@ -42,9 +42,17 @@ bool DimensionHistogram::Add(double time_s, double value_m, double sample_weight
     total_ *= decay;
     overflow_ *= decay;
     const double negligible = 1e-15 * total_;  // keeps long-gone bins out of denormal range
-    for (double& b : bins_) {
+    // The bins outside the range hold 0, which the decay and the cut leave 0.
+    for (int i = nonzero_lo_; i <= nonzero_hi_; ++i) {
+      double& b = bins_[static_cast<std::size_t>(i)];
       b *= decay;
       if (b < negligible) b = 0.0;
+    }
+    while (nonzero_lo_ <= nonzero_hi_ && bins_[static_cast<std::size_t>(nonzero_lo_)] == 0.0) {
+      ++nonzero_lo_;
+    }
+    while (nonzero_hi_ >= nonzero_lo_ && bins_[static_cast<std::size_t>(nonzero_hi_)] == 0.0) {
+      --nonzero_hi_;
     }
     newest_time_ = time_s;
   } else {
@@ -62,6 +70,14 @@ bool DimensionHistogram::Add(double time_s, double value_m, double sample_weight
     const auto i = static_cast<std::size_t>(lower);
     bins_[i] += weight * (1.0 - frac);
     if (frac > 0.0) bins_[i + 1] += weight * frac;
+    const int first = static_cast<int>(i), last_written = frac > 0.0 ? first + 1 : first;
+    if (nonzero_hi_ < nonzero_lo_) {
+      nonzero_lo_ = first;
+      nonzero_hi_ = last_written;
+    } else {
+      nonzero_lo_ = std::min(nonzero_lo_, first);
+      nonzero_hi_ = std::max(nonzero_hi_, last_written);
+    }
   }
   total_ += weight;
   return true;
@@ -86,9 +102,10 @@ std::optional<double> DimensionHistogram::Estimate() const {
   // Only bins [i0, i1] hold weight (a track's samples span a few dozen of the hundreds of bins):
   // the steps below skip the empty ends, where nothing changes (no quantile step, a smoothed
   // value of exactly 0, no peak).
-  int i0 = 0, i1 = n - 1;
-  while (i0 < n && bins_[i0] == 0.0) ++i0;
-  if (i0 == n) return std::nullopt;  // only samples above the range: no peak (as in step 3)
+  // (bins outside [nonzero_lo_, nonzero_hi_] hold 0: the first and last non-zero bins lie in it).
+  int i0 = nonzero_lo_, i1 = nonzero_hi_;
+  while (i0 <= i1 && bins_[i0] == 0.0) ++i0;
+  if (i0 > i1) return std::nullopt;  // only samples above the range: no peak (as in step 3)
   while (bins_[i1] == 0.0) --i1;
 
   // 1. The (1 - excluded_fraction) weighted quantile, weight spread evenly within a bin.

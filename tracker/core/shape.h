@@ -54,6 +54,10 @@ class DimensionHistogram {
  private:
   ShapeParams params_;
   std::vector<double> bins_;    // decayed weights, bin i centred at (i + 1/2) * bin_width
+  // Every bin outside [nonzero_lo_, nonzero_hi_] holds exactly 0 (inside, some may too): a
+  // track's samples span a few dozen of the hundreds of bins, and only these are decayed and
+  // searched. Empty (hi < lo) before any sample.
+  int nonzero_lo_ = 0, nonzero_hi_ = -1;
   std::vector<double> kernel_;  // smoothing kernel, kernel_[k] for offsets -K..K
   double overflow_ = 0.0;       // decayed weight of samples above max_dimension
   double total_ = 0.0;          // decayed weight of all samples

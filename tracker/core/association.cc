@@ -155,7 +155,7 @@ double Associator::PairCost(const PredictedObject& t, double margin, std::uint8_
   if (need > n) return kInf;
   const internal::GateSums sums = internal::SumGate(box, margin, visible, n - need,
                                                     part.points.data(), n, pts.x.data(),
-                                                    pts.y.data());
+                                                    pts.y.data(), &part.blocks);
   if (sums.stopped) return kInf;
   const std::size_t inside = sums.inside;
   const double dist_sum = sums.dist_sum;
@@ -199,12 +199,20 @@ void Associator::ClaimingTracks(const Segment& s, Scratch* scratch) const {
   claim.clear();
   sorted_.Overlapping(s.min, s.max, &scratch->candidates);
   const auto n = static_cast<std::size_t>(s.end - s.begin);
+  const int need = params_.split_min_points;
   for (const std::int32_t jj : scratch->candidates) {
     const auto j = static_cast<std::size_t>(jj);
-    // Counted up to split_min_points (all the claim needs).
-    const int inside = internal::CountInside(gates_[j], n, scratch->seg_x.data(),
-                                             scratch->seg_y.data(), params_.split_min_points);
-    if (inside >= params_.split_min_points) claim.push_back(j);
+    // Counted up to split_min_points (all the claim needs), block by block in order; a block
+    // wholly outside the gate adds nothing.
+    int inside = 0;
+    for (std::size_t b = 0; b < scratch->blocks.size() && inside < need; ++b) {
+      if (internal::BlockOutsideGate(gates_[j], scratch->blocks[b])) continue;
+      const std::size_t first = b * internal::kBlockReturns;
+      inside += internal::CountInside(gates_[j], std::min(n - first, internal::kBlockReturns),
+                                      scratch->seg_x.data() + first, scratch->seg_y.data() + first,
+                                      need - inside);
+    }
+    if (inside >= need) claim.push_back(j);
   }
 }
 
@@ -223,14 +231,27 @@ void Associator::SplitAmong(const std::vector<PredictedObject>& tracks, const st
   }
   // Claimant by claimant over the segment's returns side by side (its padding's answer is not
   // used): each return still meets the claimants in order and keeps the first of the nearest.
+  // Block by block: a claimant none of whose distances to a block's returns can be below the
+  // nearest so far of any of them (BlockNearestBound above the block's largest) changes nothing
+  // there (a return takes a later claimant only if strictly nearer).
   const auto n = static_cast<std::size_t>(end - begin);
   const std::size_t padded = n + (n & 1);
   scratch->split_d.assign(padded, kInf);
   scratch->split_best.assign(padded, 0);
+  const std::size_t num_blocks = scratch->blocks.size();
+  scratch->block_max.assign(num_blocks, kInf);
   for (std::size_t c = 0; c < claimants.size(); ++c) {
-    internal::KeepNearer(claimants[c], static_cast<std::int64_t>(c), padded,
-                         scratch->seg_x.data(), scratch->seg_y.data(), scratch->split_d.data(),
-                         scratch->split_best.data());
+    for (std::size_t b = 0; b < num_blocks; ++b) {
+      if (internal::BlockNearestBound(claimants[c], scratch->blocks[b]) > scratch->block_max[b]) {
+        continue;
+      }
+      const std::size_t first = b * internal::kBlockReturns;
+      const std::size_t len = std::min(padded - first, internal::kBlockReturns);
+      scratch->block_max[b] = internal::KeepNearer(
+          claimants[c], static_cast<std::int64_t>(c), len, scratch->seg_x.data() + first,
+          scratch->seg_y.data() + first, scratch->split_d.data() + first,
+          scratch->split_best.data() + first);
+    }
   }
   for (std::size_t k = 0; k < n; ++k) {
     parts[static_cast<std::size_t>(scratch->split_best[k])].points.push_back(begin[k]);
@@ -245,9 +266,11 @@ std::size_t Associator::BoundSplit(const WorldPoints& pts, std::size_t first, st
   for (std::size_t q = first; q < end; ++q) {
     Part& part = (*parts)[q];
     if (static_cast<int>(part.points.size()) < params_.split_min_points) continue;
-    Bound(part.points.size(), pts.x.data(), pts.y.data(), part.points.data(), &part);
+    internal::BoundBlocks(part.points.size(), pts.x.data(), pts.y.data(), part.points.data(),
+                          &part.blocks, &part.min, &part.max);
     if (w != q) {
       std::swap((*parts)[w].points, part.points);
+      std::swap((*parts)[w].blocks, part.blocks);
       (*parts)[w].min = part.min;
       (*parts)[w].max = part.max;
     }
@@ -277,6 +300,9 @@ std::size_t Associator::PartsOf(const std::vector<PredictedObject>& tracks, cons
       scratch->seg_x[n] = scratch->seg_x[n - 1];
       scratch->seg_y[n] = scratch->seg_y[n - 1];
     }
+    Eigen::Vector2d seg_lo, seg_hi;
+    internal::BoundBlocks(n, scratch->seg_x.data(), scratch->seg_y.data(), nullptr, &scratch->blocks,
+                          &seg_lo, &seg_hi);
     ClaimingTracks(s, scratch);
     const std::size_t first = used;
     const std::size_t num_parts = scratch->claim.size() >= 2 ? scratch->claim.size() : 1;
@@ -285,7 +311,9 @@ std::size_t Associator::PartsOf(const std::vector<PredictedObject>& tracks, cons
     if (num_parts == 1) {
       Part& part = (*parts)[first];
       part.points.assign(seg_begin_point, seg_end_point);
-      Bound(n, scratch->seg_x.data(), scratch->seg_y.data(), nullptr, &part);
+      part.min = seg_lo;
+      part.max = seg_hi;
+      part.blocks = scratch->blocks;
       used = first + 1;
     } else {
       SplitAmong(tracks, seg_begin_point, seg_end_point, scratch, parts->data() + first);
@@ -335,6 +363,7 @@ void Associator::BuildParts(const std::vector<PredictedObject>& tracks, const Wo
     if (parts_.size() < num_parts_ + block_num_parts_[b]) parts_.resize(num_parts_ + block_num_parts_[b]);
     for (std::size_t q = 0; q < block_num_parts_[b]; ++q, ++num_parts_) {
       std::swap(parts_[num_parts_].points, block[q].points);  // buffers swapped, kept for reuse
+      std::swap(parts_[num_parts_].blocks, block[q].blocks);
       parts_[num_parts_].min = block[q].min;
       parts_[num_parts_].max = block[q].max;
     }

@@ -96,11 +96,17 @@ class Associator {
   struct RectFrame {
     double cx, cy, ax, ay, hl, hw;
   };
+  // A block of a segment's returns: every one lies within radius of (cx, cy)
+  // (internal::BoundBlocks).
+  struct ReturnBlock {
+    double cx, cy, radius;
+  };
 
  private:
   struct Part {  // a segment, or one piece of a split segment
     std::vector<std::int32_t> points;
     Eigen::Vector2d min, max;
+    std::vector<ReturnBlock> blocks;  // of points, in order (internal::BoundBlocks)
   };
   // Boxes sorted by their lower x bound, for the overlap tests of boxes against boxes (tracks'
   // gates against segments or parts): those are O(tracks x segments), most of them disjoint.
@@ -140,6 +146,8 @@ class Associator {
     ReturnArray<double> seg_x, seg_y;
     std::vector<double> split_d;           // split: per return, its distance to the nearest claimant
     std::vector<std::int64_t> split_best;  // split: per return, that claimant
+    std::vector<ReturnBlock> blocks;       // the segment's returns in blocks (internal::kBlockReturns)
+    std::vector<double> block_max;         // split: per block, the largest split_d in it
   };
   void IndexClaimingGates(const std::vector<PredictedObject>& tracks);
   // The parts of segments [seg_begin, seg_end), in segment order, into (*parts)[0, returned
@@ -158,18 +166,6 @@ class Associator {
   // the new end.
   std::size_t BoundSplit(const WorldPoints& pts, std::size_t first, std::size_t end,
                          std::vector<Part>* parts) const;
-  // part's bounding box: of (x[k], y[k]), k < n, or of (x[idx[k]], y[idx[k]]) if idx is given.
-  static void Bound(std::size_t n, const double* x, const double* y, const std::int32_t* idx,
-                    Part* part) {
-    part->min = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
-    part->max = -part->min;
-    for (std::size_t k = 0; k < n; ++k) {
-      const auto i = idx != nullptr ? static_cast<std::size_t>(idx[k]) : k;
-      const Eigen::Vector2d p(x[i], y[i]);
-      part->min = part->min.cwiseMin(p);
-      part->max = part->max.cwiseMax(p);
-    }
-  }
   // Candidate pairs with their costs, in (track, part) order.
   void CandidatePairs(const std::vector<PredictedObject>& tracks, const WorldPoints& pts,
                       const Eigen::Vector2d& sensor_xy, std::vector<Pair>* pairs);

@@ -16,6 +16,7 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <vector>
 
 #include "tracker/core/association.h"
 #include "tracker/core/double2.h"
@@ -44,10 +45,13 @@ struct GateSums {
   bool stopped = false;     // outside exceeded max_outside (the sums stop at that return)
 };
 // box: the rectangle's frame and half sizes; a return is outside the gate if |qx| > hl + margin
-// or |qy| > hw + margin in that frame.
+// or |qy| > hw + margin in that frame. blocks: null, or the returns' blocks (BoundBlocks), each
+// wholly outside the gate (BlockOutsideGate) counted at once, its returns not visited: the same
+// sums.
 inline GateSums SumGate(const Associator::RectFrame& box, double margin, std::uint8_t visible,
                  std::size_t max_outside, const std::int32_t* idx, std::size_t n,
-                 const double* x, const double* y);
+                 const double* x, const double* y,
+                 const std::vector<Associator::ReturnBlock>* blocks = nullptr);
 
 // True if the axis-aligned box [lo, hi] lies wholly outside the gate (box's rectangle grown by
 // margin) along one of the gate's axes: then SumGate finds every return in [lo, hi] outside.
@@ -67,8 +71,33 @@ inline int CountInside(const Associator::RectFrame& gate, std::size_t n, const d
 // For returns (x[k], y[k]), k < n (even), the signed distance d to the boundary of rectangle f
 // (> 0 outside: the squared distance; <= 0 inside: minus the distance to the nearest side),
 // kept with c in best_d[k], best[k] where d < best_d[k]. Two returns per step, without branches.
-inline void KeepNearer(const Associator::RectFrame& f, std::int64_t c, std::size_t n, const double* x,
+// Returns the largest best_d[k], k < n, after the update.
+inline double KeepNearer(const Associator::RectFrame& f, std::int64_t c, std::size_t n, const double* x,
                 const double* y, double* best_d, std::int64_t* best);
+
+// Blocks of a segment's returns side by side, for the claims and the split of large segments
+// (walls, vegetation), whose returns mostly lie far outside most of the gates and rectangles
+// that overlap the segment's bounding box: a block's bound spares the loops over its returns
+// where their answer is known from it. Block b holds returns [b * kBlockReturns, min((b + 1) *
+// kBlockReturns, n)) (even-sized but the last, so that the two-lane loops keep their pairs).
+inline constexpr std::size_t kBlockReturns = 64;
+// Every return of the block lies within radius of (cx, cy) (padded for rounding, below).
+using ReturnBlock = Associator::ReturnBlock;
+// The blocks of returns (x[k], y[k]), k < n, or of (x[idx[k]], y[idx[k]]) if idx is given, and
+// (lo, hi: if given) the bounding box of them all (+inf, -inf for none).
+inline void BoundBlocks(std::size_t n, const double* x, const double* y, const std::int32_t* idx,
+                        std::vector<ReturnBlock>* blocks, Eigen::Vector2d* lo = nullptr,
+                        Eigen::Vector2d* hi = nullptr);
+// True if no return of the block lies inside the gate (|qx| <= hl, |qy| <= hw in its frame, as
+// CountInside computes them): the block's centre lies beyond the gate by more than its radius
+// along one of the gate's axes, with a margin for rounding (1e-9 of the distances involved,
+// far beyond the last bits of either computation). False for anything not finite.
+inline bool BlockOutsideGate(const Associator::RectFrame& gate, const ReturnBlock& block);
+// A lower bound of the distance KeepNearer computes for any return of the block to rectangle f:
+// the signed distance to a rectangle changes by at most the distance moved, so it is at least
+// the centre's less the radius (and less a margin for rounding), and KeepNearer's d is a
+// non-decreasing function of it (d = s^2 outside, s inside). NaN for anything not finite.
+inline double BlockNearestBound(const Associator::RectFrame& f, const ReturnBlock& block);
 
 // ---- RANSAC
 
@@ -163,16 +192,49 @@ inline Double2 NearestFaceSq2(Double2 qx, Double2 qy, std::uint8_t visible, doub
   return d2;
 }
 
+inline void SumGateRange(const Associator::RectFrame& box, double margin, std::uint8_t visible,
+                         std::size_t max_outside, const std::int32_t* idx, std::size_t begin,
+                         std::size_t n, const double* x, const double* y, GateSums* sums_out);
+
 inline GateSums SumGate(const Associator::RectFrame& box, double margin, std::uint8_t visible,
                  std::size_t max_outside, const std::int32_t* idx, std::size_t n,
-                 const double* x, const double* y) {
+                 const double* x, const double* y,
+                 const std::vector<Associator::ReturnBlock>* blocks) {
   GateSums sums;
+  if (blocks == nullptr) {
+    SumGateRange(box, margin, visible, max_outside, idx, 0, n, x, y, &sums);
+    return sums;
+  }
+  const Associator::RectFrame gate{box.cx, box.cy, box.ax, box.ay, box.hl + margin, box.hw + margin};
+  for (std::size_t b = 0; b < blocks->size(); ++b) {
+    const std::size_t begin = b * kBlockReturns, end = std::min(n, begin + kBlockReturns);
+    if (BlockOutsideGate(gate, (*blocks)[b])) {
+      // Every return outside: the count, or the stop at the return that passes max_outside.
+      sums.outside += end - begin;
+      sums.stopped = sums.outside > max_outside;
+      if (sums.stopped) {
+        sums.outside = max_outside + 1;
+        return sums;
+      }
+      continue;
+    }
+    SumGateRange(box, margin, visible, max_outside, idx, begin, end, x, y, &sums);
+    if (sums.stopped) return sums;
+  }
+  return sums;
+}
+
+// SumGate's sums continued over the returns idx[k], begin <= k < n.
+inline void SumGateRange(const Associator::RectFrame& box, double margin, std::uint8_t visible,
+                         std::size_t max_outside, const std::int32_t* idx, std::size_t begin,
+                         std::size_t n, const double* x, const double* y, GateSums* sums_out) {
+  GateSums& sums = *sums_out;
   // Two returns per step (an odd last one twice, its second lane unused), then lane by lane in
   // order: the same counts, early stop and sum as one return at a time.
   const Double2 cx = Splat(box.cx), cy = Splat(box.cy);
   const Double2 ax = Splat(box.ax), ay = Splat(box.ay);
   const Double2 gate_l = Splat(box.hl + margin), gate_w = Splat(box.hw + margin);
-  for (std::size_t k = 0; k < n; k += 2) {
+  for (std::size_t k = begin; k < n; k += 2) {
     const auto i0 = static_cast<std::size_t>(idx[k]);
     const auto i1 = static_cast<std::size_t>(idx[k + 1 < n ? k + 1 : k]);
     const Double2 dx = Double2{x[i0], x[i1]} - cx, dy = Double2{y[i0], y[i1]} - cy;
@@ -182,14 +244,13 @@ inline GateSums SumGate(const Associator::RectFrame& box, double margin, std::ui
     for (std::size_t lane = 0; lane < 2 && k + lane < n; ++lane) {
       if (out[lane]) {
         sums.stopped = ++sums.outside > max_outside;
-        if (sums.stopped) return sums;
+        if (sums.stopped) return;
         continue;
       }
       ++sums.inside;
       sums.dist_sum += std::sqrt(d2[lane]);
     }
   }
-  return sums;
 }
 
 inline bool BoxOutsideGate(const Associator::RectFrame& box, double margin,
@@ -229,11 +290,12 @@ inline int CountInside(const Associator::RectFrame& gate, std::size_t n, const d
   return inside;
 }
 
-inline void KeepNearer(const Associator::RectFrame& f, std::int64_t c, std::size_t n, const double* x,
+inline double KeepNearer(const Associator::RectFrame& f, std::int64_t c, std::size_t n, const double* x,
                 const double* y, double* best_d, std::int64_t* best) {
   const Double2 cx = Splat(f.cx), cy = Splat(f.cy), ax = Splat(f.ax), ay = Splat(f.ay);
   const Double2 hl = Splat(f.hl), hw = Splat(f.hw), zero = Splat(0.0);
   const Mask2 claimant = {c, c};
+  Double2 largest = Splat(-std::numeric_limits<double>::infinity());
   for (std::size_t k = 0; k < n; k += 2) {
     const Double2 px = Load2(x + k), py = Load2(y + k), old = Load2(best_d + k);
     Mask2 old_best;
@@ -248,7 +310,59 @@ inline void KeepNearer(const Associator::RectFrame& f, std::int64_t c, std::size
     const Mask2 new_best = nearer ? claimant : old_best;
     std::memcpy(best_d + k, &new_d, sizeof new_d);
     std::memcpy(best + k, &new_best, sizeof new_best);
+    largest = Max2(largest, new_d);
   }
+  return std::max(largest[0], largest[1]);
+}
+
+inline void BoundBlocks(std::size_t n, const double* x, const double* y, const std::int32_t* idx,
+                        std::vector<ReturnBlock>* blocks, Eigen::Vector2d* lo,
+                        Eigen::Vector2d* hi) {
+  blocks->clear();
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  Eigen::Vector2d all_lo(kInf, kInf), all_hi(-kInf, -kInf);
+  const auto at = [idx](std::size_t k) { return idx != nullptr ? static_cast<std::size_t>(idx[k]) : k; };
+  for (std::size_t begin = 0; begin < n; begin += kBlockReturns) {
+    const std::size_t end = std::min(n, begin + kBlockReturns);
+    double x_lo = x[at(begin)], x_hi = x_lo, y_lo = y[at(begin)], y_hi = y_lo;
+    for (std::size_t k = begin + 1; k < end; ++k) {
+      const std::size_t i = at(k);
+      x_lo = std::min(x_lo, x[i]);
+      x_hi = std::max(x_hi, x[i]);
+      y_lo = std::min(y_lo, y[i]);
+      y_hi = std::max(y_hi, y[i]);
+    }
+    const double cx = 0.5 * (x_lo + x_hi), cy = 0.5 * (y_lo + y_hi);
+    // Half the diagonal, padded for the rounding of the centre (1e-9 of the coordinates).
+    const double scale = 1.0 + std::max({std::abs(x_lo), std::abs(x_hi), std::abs(y_lo), std::abs(y_hi)});
+    const double radius = 0.5 * std::sqrt((x_hi - x_lo) * (x_hi - x_lo) + (y_hi - y_lo) * (y_hi - y_lo)) +
+                          1e-9 * scale;
+    blocks->push_back({cx, cy, radius});
+    all_lo = all_lo.cwiseMin(Eigen::Vector2d(x_lo, y_lo));
+    all_hi = all_hi.cwiseMax(Eigen::Vector2d(x_hi, y_hi));
+  }
+  if (lo != nullptr) *lo = all_lo;
+  if (hi != nullptr) *hi = all_hi;
+}
+
+inline bool BlockOutsideGate(const Associator::RectFrame& gate, const ReturnBlock& block) {
+  const double dx = block.cx - gate.cx, dy = block.cy - gate.cy;
+  const double qx = dx * gate.ax + dy * gate.ay, qy = -dx * gate.ay + dy * gate.ax;
+  const double pad = block.radius + 1e-9 * (1.0 + std::abs(dx) + std::abs(dy) + gate.hl + gate.hw);
+  return std::abs(qx) - pad > gate.hl || std::abs(qy) - pad > gate.hw;  // NaN: false
+}
+
+inline double BlockNearestBound(const Associator::RectFrame& f, const ReturnBlock& block) {
+  const double dx = block.cx - f.cx, dy = block.cy - f.cy;
+  const double qx = dx * f.ax + dy * f.ay, qy = -dx * f.ay + dy * f.ax;
+  const double ex = std::abs(qx) - f.hl, ey = std::abs(qy) - f.hw;
+  const double s = ex > 0.0 || ey > 0.0
+                       ? std::sqrt(std::max(ex, 0.0) * std::max(ex, 0.0) + std::max(ey, 0.0) * std::max(ey, 0.0))
+                       : std::max(ex, ey);
+  const double lb = s - block.radius - 1e-9 * (1.0 + std::abs(dx) + std::abs(dy) + f.hl + f.hw);
+  if (!std::isfinite(lb)) return std::numeric_limits<double>::quiet_NaN();
+  // d's own rounding (a relative few 1e-16 of a square): 1e-9 of it below.
+  return lb > 0.0 ? lb * lb * (1.0 - 1e-9) : lb;
 }
 
 inline double EdgeCost(const PerpNoise& noise, const Subset& sub, const Eigen::Vector2d& mid,

@@ -18,6 +18,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -393,6 +394,143 @@ TEST(ReturnKernelsTest, ABoxOutsideTheGateHoldsNoReturnInside) {
   EXPECT_GT(outside, kTrials / 10);
   EXPECT_GT(outside_but_bounds_overlap, kTrials / 50);
   EXPECT_GT(single, kTrials / 10);
+}
+
+// A block's bounds hold each of its returns. Blocks of seeded clusters (round, or long and thin
+// as a wall), placed across a gate's side or anywhere about it, at every scale and offset of the
+// scenes above: where BlockOutsideGate says a block lies outside, no return of it is inside (the
+// scalar test and CountInside agree), and BlockNearestBound is at most the distance of the
+// split (reference and KeepNearer) of every return of the block; the union of the blocks'
+// boxes is the returns' bounding box.
+TEST(ReturnKernelsTest, ABlocksBoundsHoldEachOfItsReturns) {
+  Draw d(19);
+  int outside = 0, below = 0, blocks_seen = 0;
+  for (int trial = 0; trial < kTrials; ++trial) {
+    const Placement p = DrawPlacement(d);
+    const RectFrame gate = DrawFrame(d, p);
+    // The cluster about a point near one of the gate's sides, or anywhere within reach of it.
+    const double near = p.grid ? p.scale * d.Quarters(-4, 4) : d.U(-p.scale, p.scale);
+    const double along = p.grid ? p.scale * d.Quarters(-24, 24) : d.U(-gate.hl - gate.hw, gate.hl + gate.hw);
+    const bool across = d.OneIn(2);
+    const double side = d.OneIn(2) ? 1.0 : -1.0;
+    const double u = across ? side * gate.hl + near : along, v = across ? along : side * gate.hw + near;
+    RectFrame centre{gate.cx + u * gate.ax - v * gate.ay, gate.cy + u * gate.ay + v * gate.ax,
+                     gate.ax, gate.ay, 0.0, 0.0};
+    if (d.OneIn(3)) {  // a wall: returns along a line at another heading
+      const double theta = d.U(-kPi, kPi);
+      centre.ax = std::cos(theta);
+      centre.ay = std::sin(theta);
+    }
+    std::vector<double> x, y;
+    const int n = d.OneIn(4) ? d.I(1, 3) : d.I(4, 200);
+    const double reach = p.scale * (d.OneIn(2) ? 0.5 : 3.0);
+    AddReturns(d, p, centre, reach, n, &x, &y);
+    if (d.OneIn(3)) {  // flattened to a line through the centre
+      for (std::size_t k = 0; k < x.size(); ++k) {
+        const double t = (x[k] - centre.cx) * centre.ax + (y[k] - centre.cy) * centre.ay;
+        x[k] = centre.cx + t * centre.ax;
+        y[k] = centre.cy + t * centre.ay;
+      }
+    }
+    std::vector<std::int32_t> order(x.size());
+    std::iota(order.begin(), order.end(), 0);
+    const bool gather = d.OneIn(2);
+    if (gather) std::shuffle(order.begin(), order.end(), d.rng);
+    std::vector<ReturnBlock> blocks;
+    Eigen::Vector2d lo, hi;
+    BoundBlocks(x.size(), x.data(), y.data(), gather ? order.data() : nullptr, &blocks, &lo, &hi);
+    SCOPED_TRACE(trial);
+    ASSERT_EQ(blocks.size(), (x.size() + kBlockReturns - 1) / kBlockReturns);
+    Eigen::Vector2d want_lo = Eigen::Vector2d::Constant(kInf), want_hi = -want_lo;
+    for (std::size_t k = 0; k < x.size(); ++k) {
+      want_lo = want_lo.cwiseMin(Eigen::Vector2d(x[k], y[k]));
+      want_hi = want_hi.cwiseMax(Eigen::Vector2d(x[k], y[k]));
+    }
+    EXPECT_EQ(lo, want_lo);
+    EXPECT_EQ(hi, want_hi);
+    const RectFrame other = DrawFrame(d, p);
+    for (std::size_t b = 0; b < blocks.size(); ++b) {
+      ++blocks_seen;
+      const std::size_t first = b * kBlockReturns, end = std::min(x.size(), first + kBlockReturns);
+      std::vector<std::int32_t> idx(order.begin() + static_cast<std::ptrdiff_t>(first),
+                                    order.begin() + static_cast<std::ptrdiff_t>(end));
+      if (BlockOutsideGate(gate, blocks[b])) {
+        ++outside;
+        EXPECT_EQ(CountInsideRef(gate, idx, x, y, kTrials), 0);
+        const SideBySide q = Gathered(Part{x, y, idx}, gate.cx, gate.cx);
+        EXPECT_EQ(CountInside(gate, idx.size(), q.x.data(), q.y.data(), kTrials), 0);
+      }
+      for (const RectFrame& f : {gate, other}) {
+        const double bound = BlockNearestBound(f, blocks[b]);
+        if (std::isnan(bound)) continue;
+        const SideBySide q = Gathered(Part{x, y, idx}, x[static_cast<std::size_t>(idx.back())],
+                                      y[static_cast<std::size_t>(idx.back())]);
+        std::vector<double> best_d(q.x.size(), kInf);
+        std::vector<std::int64_t> best(q.x.size(), 0);
+        const double largest = KeepNearer(f, 0, q.x.size(), q.x.data(), q.y.data(), best_d.data(), best.data());
+        EXPECT_EQ(largest, *std::max_element(best_d.begin(), best_d.end()));
+        for (std::size_t k = 0; k < idx.size(); ++k) {
+          const auto i = static_cast<std::size_t>(idx[k]);
+          EXPECT_LE(bound, SplitDistanceRef(f, x[i], y[i])) << "return " << k << " of block " << b;
+          EXPECT_LE(bound, best_d[k]);
+          below += bound > -kInf && best_d[k] - bound < 1e-3 * p.scale ? 1 : 0;
+        }
+      }
+    }
+  }
+  // The scenes reach both tests often, and bounds near the returns' distances.
+  EXPECT_GT(outside, kTrials / 10);
+  EXPECT_GT(blocks_seen, kTrials + kTrials / 2);  // several blocks per cluster, often
+  EXPECT_GT(below, kTrials / 10);
+}
+
+// SumGate over a part's blocks, those outside the gate counted at once, gives the sums of the
+// return-by-return loop to the bit (the same counts, stop and sum in order), for parts of up to
+// 300 returns in random order, every stop threshold.
+TEST(ReturnKernelsTest, GateSumsOverBlocksAreThoseOfOneReturnAtATime) {
+  Draw d(23);
+  int skipped = 0;
+  for (int trial = 0; trial < kTrials; ++trial) {
+    const Placement p = DrawPlacement(d);
+    const RectFrame box = DrawFrame(d, p);
+    const double margin = p.grid ? p.scale * d.Quarters(0, 4) : p.scale * d.U(0.0, 1.0);
+    const int n = d.I(1, 300);
+    // Returns spread along a wall through the gate: most of them far outside it.
+    Part part;
+    const double theta = d.U(-kPi, kPi);
+    const RectFrame wall{box.cx, box.cy, std::cos(theta), std::sin(theta), 0.0, 0.0};
+    for (int k = 0; k < n + d.I(0, 4); ++k) {
+      const double t = p.scale * (p.grid ? d.Quarters(-200, 200) : d.U(-50.0, 50.0));
+      const double w = p.scale * (p.grid ? d.Quarters(-2, 2) : d.U(-0.5, 0.5));
+      part.x.push_back(wall.cx + t * wall.ax - w * wall.ay);
+      part.y.push_back(wall.cy + t * wall.ay + w * wall.ax);
+    }
+    part.idx.resize(part.x.size());
+    std::iota(part.idx.begin(), part.idx.end(), 0);
+    std::sort(part.idx.begin(), part.idx.end(), [&](std::int32_t a, std::int32_t b) {
+      return part.x[static_cast<std::size_t>(a)] < part.x[static_cast<std::size_t>(b)];
+    });  // in order along the wall, as a segment's cells come
+    part.idx.resize(static_cast<std::size_t>(n));
+    std::vector<ReturnBlock> blocks;
+    BoundBlocks(part.idx.size(), part.x.data(), part.y.data(), part.idx.data(), &blocks);
+    const RectFrame gate{box.cx, box.cy, box.ax, box.ay, box.hl + margin, box.hw + margin};
+    for (const ReturnBlock& b : blocks) skipped += BlockOutsideGate(gate, b) ? 1 : 0;
+    const std::uint8_t visible = static_cast<std::uint8_t>(d.I(1, 15));
+    const std::size_t max_outside = static_cast<std::size_t>(d.I(0, n));
+    const GateSums want = SumGate(box, margin, visible, max_outside, part.idx.data(), part.idx.size(),
+                                  part.x.data(), part.y.data());
+    const GateSums got = SumGate(box, margin, visible, max_outside, part.idx.data(), part.idx.size(),
+                                 part.x.data(), part.y.data(), &blocks);
+    const GateSums ref = SumGateRef(box, margin, visible, max_outside, part.idx, part.x, part.y);
+    SCOPED_TRACE(trial);
+    EXPECT_EQ(got.inside, want.inside);
+    EXPECT_EQ(got.outside, want.outside);
+    EXPECT_EQ(got.stopped, want.stopped);
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(got.dist_sum), std::bit_cast<std::uint64_t>(want.dist_sum));
+    EXPECT_EQ(got.inside, ref.inside);
+    EXPECT_EQ(got.stopped, ref.stopped);
+  }
+  EXPECT_GT(skipped, kTrials);  // blocks wholly outside are common
 }
 
 TEST(ReturnKernelsTest, ClaimCountIsThatOfOneReturnAtATime) {

@@ -47,7 +47,7 @@ struct GateSums {
 // box: the rectangle's frame and half sizes; a return is outside the gate if |qx| > hl + margin
 // or |qy| > hw + margin in that frame. blocks: null, or the returns' blocks (BoundBlocks), each
 // wholly outside the gate (BlockOutsideGate) counted at once, its returns not visited: the same
-// sums.
+// sums (blocks of another count than n's are not used).
 inline GateSums SumGate(const Associator::RectFrame& box, double margin, std::uint8_t visible,
                  std::size_t max_outside, const std::int32_t* idx, std::size_t n,
                  const double* x, const double* y,
@@ -201,7 +201,8 @@ inline GateSums SumGate(const Associator::RectFrame& box, double margin, std::ui
                  const double* x, const double* y,
                  const std::vector<Associator::ReturnBlock>* blocks) {
   GateSums sums;
-  if (blocks == nullptr) {
+  // Blocks not of these n returns (none given, or another count): the returns one by one.
+  if (blocks == nullptr || blocks->size() != (n + kBlockReturns - 1) / kBlockReturns) {
     SumGateRange(box, margin, visible, max_outside, idx, 0, n, x, y, &sums);
     return sums;
   }

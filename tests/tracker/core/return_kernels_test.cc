@@ -529,6 +529,13 @@ TEST(ReturnKernelsTest, GateSumsOverBlocksAreThoseOfOneReturnAtATime) {
     EXPECT_EQ(std::bit_cast<std::uint64_t>(got.dist_sum), std::bit_cast<std::uint64_t>(want.dist_sum));
     EXPECT_EQ(got.inside, ref.inside);
     EXPECT_EQ(got.stopped, ref.stopped);
+    // Blocks of other returns (here: of the part less its last block) are not used.
+    std::vector<ReturnBlock> stale(blocks.begin(), blocks.end() - 1);
+    if (!stale.empty()) stale.front() = {box.cx + 1e6 * p.scale, box.cy, 0.0};  // would skip
+    const GateSums plain = SumGate(box, margin, visible, max_outside, part.idx.data(),
+                                   part.idx.size(), part.x.data(), part.y.data(), &stale);
+    EXPECT_EQ(plain.inside, want.inside);
+    EXPECT_EQ(plain.outside, want.outside);
   }
   EXPECT_GT(skipped, kTrials);  // blocks wholly outside are common
 }

@@ -411,7 +411,7 @@ double TrackManager::ObserveEvidence(std::size_t index, const ReturnEvidence& r,
   Track& t = tracks_[index];
   const TrackHypothesis& sel = t.hyps[static_cast<std::size_t>(t.selected)];
   const EvidenceFeatures f = FeaturesOf(r, t, ekf_.Centre(sel.filter).speed);
-  const double logit = ScanLogit(evidence_, r.three_d, f);
+  const double logit = ScanLogit(evidence_, r.three_d, f, evidence_roots_);
   // The first evidence: the track starts at the prior of the model that measured it.
   if (!t.evidence_seen) t.vehicle_log_odds = PriorLogOdds(evidence_, r.three_d);
   t.evidence_seen = true;

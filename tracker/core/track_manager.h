@@ -171,7 +171,10 @@ class TrackManager {
   // vehicle from a mean box score of vehicle_box_score on; with needs_box (fused input) a track no
   // box has updated lately is other, whatever its size.
   // The vehicle-evidence model (vehicle_evidence.h); before any call, the defaults.
-  void SetEvidence(const EvidenceParams& evidence) { evidence_ = evidence; }
+  void SetEvidence(const EvidenceParams& evidence) {
+    evidence_ = evidence;
+    evidence_roots_ = EvidenceRoots(evidence_);
+  }
   // One scan's returns r of track index, after its update or creation: the features (with the
   // track's state), the scan's logit added to the track's log-odds; the features in *features
   // if not null. Returns the scan's logit.
@@ -253,6 +256,7 @@ class TrackManager {
   std::vector<Track> tracks_;
   std::int64_t next_id_ = 1;
   EvidenceParams evidence_;
+  EvidenceRoots evidence_roots_{evidence_};  // of evidence_: declared after it
   bool vehicle_needs_box_ = false;
   double vehicle_box_score_ = -std::numeric_limits<double>::infinity();  // [-] detector's scale
 };

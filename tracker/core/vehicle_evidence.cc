@@ -229,13 +229,13 @@ bool UsesFeature(const EvidenceParams& p, bool three_d, EvidenceFeature k) {
 
 namespace {
 
-// The sum of the leaves the scan reaches, one per tree (EvidenceNode).
-double TreesLogit(const std::vector<EvidenceNode>& nodes, const EvidenceFeatures& f) {
+// The sum of the leaves the scan reaches, one per tree (EvidenceNode; roots: TreeRoots(nodes)),
+// tree after tree.
+double TreesLogit(const std::vector<EvidenceNode>& nodes, const std::vector<std::int32_t>& roots,
+                  const EvidenceFeatures& f) {
   double l = 0.0;
-  const std::size_t n = nodes.size();
-  for (std::size_t root = 0; root < n; ++root) {
-    if (root > 0 && nodes[root].tree == nodes[root - 1].tree) continue;  // not a tree's first node
-    std::size_t i = root;
+  for (const std::int32_t root : roots) {
+    auto i = static_cast<std::size_t>(root);
     while (nodes[i].left >= 0) {
       const EvidenceNode& node = nodes[i];
       const double v = f[static_cast<std::size_t>(node.feature)];
@@ -299,10 +299,23 @@ std::string EvidenceParams::CrossProblem() const {
   return problem.empty() ? TreeProblem("trees_2d", trees_2d) : problem;
 }
 
+std::vector<std::int32_t> TreeRoots(const std::vector<EvidenceNode>& nodes) {
+  std::vector<std::int32_t> roots;
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    if (k == 0 || nodes[k].tree != nodes[k - 1].tree) roots.push_back(static_cast<std::int32_t>(k));
+  }
+  return roots;
+}
+
 double ScanLogit(const EvidenceParams& p, bool three_d, const EvidenceFeatures& f) {
+  return ScanLogit(p, three_d, f, EvidenceRoots(p));
+}
+
+double ScanLogit(const EvidenceParams& p, bool three_d, const EvidenceFeatures& f,
+                 const EvidenceRoots& roots) {
   const double bias = three_d ? p.bias_3d : p.bias_2d;
   if ((three_d ? p.model_3d : p.model_2d) == EvidenceModel::kTrees) {
-    return bias + TreesLogit(three_d ? p.trees_3d : p.trees_2d, f);
+    return bias + TreesLogit(three_d ? p.trees_3d : p.trees_2d, three_d ? roots.three_d : roots.two_d, f);
   }
   double l = bias;
   for (const EvidenceTerm& term : three_d ? p.terms_3d : p.terms_2d) {

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <random>
 #include <string>
@@ -190,6 +191,53 @@ TEST(VehicleEvidence, TreesSumTheLeavesTheScanReachesAndSendMissingFeaturesLeft)
   bad.trees_2d[5].tree = 0;  // tree numbers must not go down ...
   bad.trees_2d[4].tree = 1;
   EXPECT_FALSE(bad.Validate(&error));
+}
+
+// The trees' roots found once (EvidenceRoots, as the track manager scores) against a walk over
+// every node written here: the first node of each tree, and for the shipped models (50 trees
+// each) the very logit of that walk, over seeded feature vectors of every scale with missing
+// features among them.
+TEST(VehicleEvidence, TreeRootsFoundOnceGiveTheLogitOfAWalkOverEveryNode) {
+  using F = EvidenceFeature;
+  const std::vector<EvidenceNode> three_trees = {
+      {0, F::kWidth, 1.0, 1, 2, 0.0}, {0, F::kLogPoints, 0.0, -1, -1, 0.3},
+      {0, F::kLogPoints, 0.0, -1, -1, -0.2}, {1, F::kLogPoints, 0.0, -1, -1, 0.05},
+      {2, F::kLength, 3.0, 5, 6, 0.0}, {2, F::kLogPoints, 0.0, -1, -1, 1.0},
+      {2, F::kLogPoints, 0.0, -1, -1, 2.0}};
+  EXPECT_EQ(TreeRoots(three_trees), (std::vector<std::int32_t>{0, 3, 4}));
+  EXPECT_TRUE(TreeRoots({}).empty());
+
+  const EvidenceParams p;  // the shipped models
+  ASSERT_EQ(p.model_3d, EvidenceModel::kTrees);
+  ASSERT_EQ(p.model_2d, EvidenceModel::kTrees);
+  const EvidenceRoots roots(p);
+  EXPECT_EQ(roots.three_d.size(), 50u);
+  EXPECT_EQ(roots.two_d.size(), 50u);
+  // The reference: every node visited in order, a tree's walk started at each change of tree.
+  const auto walk_every_node = [](const std::vector<EvidenceNode>& nodes, double bias,
+                                  const EvidenceFeatures& f) {
+    double l = 0.0;
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      if (k > 0 && nodes[k].tree == nodes[k - 1].tree) continue;
+      std::size_t i = k;
+      while (nodes[i].left >= 0) {
+        const double v = f[static_cast<std::size_t>(nodes[i].feature)];
+        i = static_cast<std::size_t>(v > nodes[i].threshold ? nodes[i].right : nodes[i].left);
+      }
+      l += nodes[i].value;
+    }
+    return bias + l;
+  };
+  std::mt19937 rng(1203u);
+  std::uniform_real_distribution<double> value(-1.0, 12.0);
+  std::bernoulli_distribution missing(0.1);
+  for (int k = 0; k < 2000; ++k) {
+    EvidenceFeatures f{};
+    for (double& v : f) v = missing(rng) ? std::numeric_limits<double>::quiet_NaN() : value(rng);
+    EXPECT_EQ(ScanLogit(p, true, f, roots), walk_every_node(p.trees_3d, p.bias_3d, f)) << "vector " << k;
+    EXPECT_EQ(ScanLogit(p, false, f, roots), walk_every_node(p.trees_2d, p.bias_2d, f)) << "vector " << k;
+    EXPECT_EQ(ScanLogit(p, true, f), ScanLogit(p, true, f, roots));
+  }
 }
 
 TEST(VehicleEvidence, ReturnsGiveTheirHeightProfileColumnTopRangeAndSegmentExtent) {

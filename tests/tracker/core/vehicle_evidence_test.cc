@@ -496,6 +496,33 @@ TEST(VehicleEvidence, TheManagerReportsAVehicleWhileItsEvidenceStaysAboveKeep) {
   EXPECT_EQ(seen, (std::vector<ObjectClass>{V, V, V, O, O, V}));
 }
 
+// Through the track manager, trees given by SetEvidence (not the defaults' 50) score the scan:
+// the logit it returns is the bias plus the leaves of the given trees, again after a second
+// SetEvidence with trees of another layout (a root kept from the first would fall elsewhere).
+TEST(VehicleEvidence, TheManagerScoresWithTheTreesItIsGiven) {
+  TrackerParams p;
+  using F = EvidenceFeature;
+  p.evidence.model_3d = EvidenceModel::kTrees;
+  p.evidence.bias_3d = 0.25;
+  p.evidence.trees_3d = {{0, F::kLogPoints, 0.0, -1, -1, 0.5}, {1, F::kLogPoints, 0.0, -1, -1, 0.125}};
+  const Ekf ekf(p.ism, p.vasm, p.ekf, p.cv);
+  TrackManager manager(p.manager, ekf, p.fit, p.shape);
+  manager.SetEvidence(p.evidence);
+  ASSERT_TRUE(manager.Create(SmallObjectReturns(), Eigen::Vector2d::Zero(), 1));
+  ReturnEvidence r;
+  r.three_d = true;
+  r.num_points = 6;  // log 6 = 1.79
+  r.range = 11.0;
+  EXPECT_EQ(manager.ObserveEvidence(0, r), 0.25 + 0.5 + 0.125);
+  // One tree of three nodes (log_points <= 1: left), then a single leaf.
+  p.evidence.trees_3d = {{0, F::kLogPoints, 1.0, 1, 2, 0.0}, {0, F::kLogPoints, 0.0, -1, -1, -4.0},
+                         {0, F::kLogPoints, 0.0, -1, -1, 2.0}, {1, F::kLogPoints, 0.0, -1, -1, 1.0}};
+  std::string error;
+  ASSERT_TRUE(p.evidence.Validate(&error)) << error;
+  manager.SetEvidence(p.evidence);
+  EXPECT_EQ(manager.ObserveEvidence(0, r), 0.25 + 2.0 + 1.0);
+}
+
 // Each model's logits are posteriors at its own prior: a track starts at the prior of the model
 // that first measures it (prior for 3-D scans, prior_2d for single-plane ones), and with
 // accumulation sum each scan's ratio is taken against that model's prior.

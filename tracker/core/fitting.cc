@@ -711,39 +711,45 @@ void ResetKeepingFlags(FitResult* out) {
   out->point_in_fit = std::move(in_fit);
 }
 
-void CheckRequest(const FitRequest& r) {
+// The message is composed only for a request refused: a stream built per fit cost about 1,000
+// instructions, some 0.5 % of a KITTI scan's.
+template <class... Parts>
+[[noreturn]] void RefuseRequest(const Parts&... parts) {
   std::ostringstream os;
-  if (r.x.size() != r.y.size()) {
-    os << "FitRequest: x has " << r.x.size() << " points but y has " << r.y.size();
-  } else if (r.x.size() > static_cast<std::size_t>(std::numeric_limits<int>::max() / 2)) {
-    os << "FitRequest: " << r.x.size() << " points are too many";
-  } else if (!r.sensor_xy.allFinite()) {
-    os << "FitRequest.sensor_xy = (" << r.sensor_xy.x() << ", " << r.sensor_xy.y()
-       << "): must be finite";
-  } else if (!(r.length_m > 0.0 && std::isfinite(r.length_m))) {
-    os << "FitRequest.length_m = " << r.length_m << ": must be > 0";
-  } else if (!(r.width_m > 0.0 && std::isfinite(r.width_m))) {
-    os << "FitRequest.width_m = " << r.width_m << ": must be > 0";
-  } else if (!(r.length_std_m >= 0.0 && std::isfinite(r.length_std_m))) {
-    os << "FitRequest.length_std_m = " << r.length_std_m << ": must be >= 0";
-  } else if (!(r.width_std_m >= 0.0 && std::isfinite(r.width_std_m))) {
-    os << "FitRequest.width_std_m = " << r.width_std_m << ": must be >= 0";
-  } else if (r.predicted_theta && !std::isfinite(*r.predicted_theta)) {
-    os << "FitRequest.predicted_theta = " << *r.predicted_theta << ": must be finite";
-  } else if (r.predicted_center && !r.predicted_center->allFinite()) {
-    os << "FitRequest.predicted_center = (" << r.predicted_center->x() << ", "
-       << r.predicted_center->y() << "): must be finite";
-  } else if (!r.profile_offset.allFinite()) {
-    os << "FitRequest.profile_offset = (" << r.profile_offset.x() << ", " << r.profile_offset.y()
-       << "): must be finite";
-  } else if (!(r.range_sigma_m > 0.0 && std::isfinite(r.range_sigma_m))) {
-    os << "FitRequest.range_sigma_m = " << r.range_sigma_m << ": must be > 0";
-  } else if (!(r.min_inside_fraction >= 0.0 && r.min_inside_fraction <= 1.0)) {
-    os << "FitRequest.min_inside_fraction = " << r.min_inside_fraction << ": must be in [0, 1]";
-  } else {
-    return;
-  }
+  (os << ... << parts);
   throw std::invalid_argument(os.str());
+}
+
+void CheckRequest(const FitRequest& r) {
+  if (r.x.size() != r.y.size()) {
+    RefuseRequest("FitRequest: x has ", r.x.size(), " points but y has ", r.y.size());
+  } else if (r.x.size() > static_cast<std::size_t>(std::numeric_limits<int>::max() / 2)) {
+    RefuseRequest("FitRequest: ", r.x.size(), " points are too many");
+  } else if (!r.sensor_xy.allFinite()) {
+    RefuseRequest("FitRequest.sensor_xy = (", r.sensor_xy.x(), ", ", r.sensor_xy.y(),
+                  "): must be finite");
+  } else if (!(r.length_m > 0.0 && std::isfinite(r.length_m))) {
+    RefuseRequest("FitRequest.length_m = ", r.length_m, ": must be > 0");
+  } else if (!(r.width_m > 0.0 && std::isfinite(r.width_m))) {
+    RefuseRequest("FitRequest.width_m = ", r.width_m, ": must be > 0");
+  } else if (!(r.length_std_m >= 0.0 && std::isfinite(r.length_std_m))) {
+    RefuseRequest("FitRequest.length_std_m = ", r.length_std_m, ": must be >= 0");
+  } else if (!(r.width_std_m >= 0.0 && std::isfinite(r.width_std_m))) {
+    RefuseRequest("FitRequest.width_std_m = ", r.width_std_m, ": must be >= 0");
+  } else if (r.predicted_theta && !std::isfinite(*r.predicted_theta)) {
+    RefuseRequest("FitRequest.predicted_theta = ", *r.predicted_theta, ": must be finite");
+  } else if (r.predicted_center && !r.predicted_center->allFinite()) {
+    RefuseRequest("FitRequest.predicted_center = (", r.predicted_center->x(), ", ",
+                  r.predicted_center->y(), "): must be finite");
+  } else if (!r.profile_offset.allFinite()) {
+    RefuseRequest("FitRequest.profile_offset = (", r.profile_offset.x(), ", ",
+                  r.profile_offset.y(), "): must be finite");
+  } else if (!(r.range_sigma_m > 0.0 && std::isfinite(r.range_sigma_m))) {
+    RefuseRequest("FitRequest.range_sigma_m = ", r.range_sigma_m, ": must be > 0");
+  } else if (!(r.min_inside_fraction >= 0.0 && r.min_inside_fraction <= 1.0)) {
+    RefuseRequest("FitRequest.min_inside_fraction = ", r.min_inside_fraction,
+                  ": must be in [0, 1]");
+  }
 }
 
 // The rectangle a candidate places (Eq. 17): heading, centre and the dimensions used, with what

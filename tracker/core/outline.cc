@@ -96,7 +96,11 @@ void OutlineExtractor::SortByBin(const PointSet& ps, const Eigen::Vector2d& s,
     bin_lo = std::min(bin_lo, bin);
     bin_hi = std::max(bin_hi, bin);
   }
-  if (keys_.size() < 2) return;
+  bin_runs_.clear();
+  if (keys_.size() < 2) {
+    if (!keys_.empty()) bin_runs_.emplace_back(0, 1);
+    return;
+  }
   // A segment's returns fill a few dozen neighbouring bins: a counting sort by bin (stable, so
   // k ascending within a bin) costs about n steps instead of n log n comparisons. Within a bin
   // PickInBin orders only what it needs. Returns beside or behind the sensor (bins far apart)
@@ -104,6 +108,13 @@ void OutlineExtractor::SortByBin(const PointSet& ps, const Eigen::Vector2d& s,
   const auto n = static_cast<std::int64_t>(keys_.size());
   if (bin_hi - bin_lo > 4 * n + 256) {
     std::sort(keys_.begin(), keys_.end());
+    std::size_t k = 0;
+    while (k < keys_.size()) {
+      std::size_t end = k + 1;
+      while (end < keys_.size() && BinOf(keys_[end].first) == BinOf(keys_[k].first)) ++end;
+      bin_runs_.emplace_back(k, end);
+      k = end;
+    }
     return;
   }
   bin_end_.assign(static_cast<std::size_t>(bin_hi - bin_lo + 2), 0);
@@ -114,6 +125,13 @@ void OutlineExtractor::SortByBin(const PointSet& ps, const Eigen::Vector2d& s,
     sorted_keys_[bin_end_[static_cast<std::size_t>(bins_[k] - bin_lo)]++] = keys_[k];
   }
   keys_.swap(sorted_keys_);
+  // bin_end_[j] is now the end of bin j (from the lowest): the runs without a scan for them.
+  std::size_t begin = 0;
+  for (std::size_t j = 0; j + 1 < bin_end_.size(); ++j) {
+    const std::size_t end = bin_end_[j];
+    if (end > begin) bin_runs_.emplace_back(begin, end);
+    begin = end;
+  }
 }
 
 void OutlineExtractor::SortBin(std::size_t begin, std::size_t end) {
@@ -138,17 +156,13 @@ double OutlineExtractor::RangeOf(std::size_t a) const {
 
 void OutlineExtractor::PickPerBin(const WorldPoints& points, const std::vector<std::int32_t>& idx,
                                   const PointSet& ps, double support_h) {
-  std::size_t k = 0;
-  while (k < keys_.size()) {
-    std::size_t end = k + 1;
-    while (end < keys_.size() && BinOf(keys_[end].first) == BinOf(keys_[k].first)) ++end;
-    const std::size_t pick = PickInBin(points, idx, k, end, support_h);
+  for (const auto& [begin, end] : bin_runs_) {
+    const std::size_t pick = PickInBin(points, idx, begin, end, support_h);
     if (pick < end) {
       const auto src = static_cast<std::size_t>(keys_[pick].second);
       outline_x_.push_back(ps.x[src]);
       outline_y_.push_back(ps.y[src]);
     }
-    k = end;
   }
 }
 
@@ -162,30 +176,41 @@ std::size_t OutlineExtractor::PickInBin(const WorldPoints& points,
     if (keys_[a] < keys_[least]) least = a;
   }
   if (!(support_h > 0.0)) return least;
-  if (HasSupport(points, idx, begin, end, least, support_h)) return least;
+  LoadBin(points, idx, begin, end);
+  if (HasSupport(least - begin, support_h)) return least;
   SortBin(begin, end);  // keys_[begin] is now the least, which has no support
+  LoadBin(points, idx, begin, end);
   for (std::size_t a = begin + 1; a < end; ++a) {
-    if (HasSupport(points, idx, begin, end, a, support_h)) return a;
+    if (HasSupport(a - begin, support_h)) return a;
   }
   return end;
 }
 
-bool OutlineExtractor::HasSupport(const WorldPoints& points, const std::vector<std::int32_t>& idx,
-                                  std::size_t begin, std::size_t end, std::size_t a,
-                                  double support_h) const {
-  auto height = [&](std::size_t e) {
-    return points.height[static_cast<std::size_t>(idx[static_cast<std::size_t>(keys_[e].second)])];
-  };
+void OutlineExtractor::LoadBin(const WorldPoints& points, const std::vector<std::int32_t>& idx,
+                               std::size_t begin, std::size_t end) {
+  // The bin's ranges and heights once, not once per entry tested (RangeOf's square root, two
+  // indirections for the height): the same values.
+  const std::int64_t base = BinOf(keys_[begin].first) * kBinScale;
+  bin_range_.resize(end - begin);
+  bin_height_.resize(end - begin);
+  for (std::size_t e = begin; e < end; ++e) {
+    bin_range_[e - begin] = std::sqrt(static_cast<double>(keys_[e].first - base) * 1e-4);
+    bin_height_[e - begin] =
+        points.height[static_cast<std::size_t>(idx[static_cast<std::size_t>(keys_[e].second)])];
+  }
+}
+
+bool OutlineExtractor::HasSupport(std::size_t a, double support_h) const {
   const double support_r = params_.support_range;
-  const double ra = RangeOf(a);
-  const float ha = height(a);
-  for (std::size_t b = begin; b < end; ++b) {
+  const double ra = bin_range_[a];
+  const float ha = bin_height_[a];
+  for (std::size_t b = 0; b < bin_range_.size(); ++b) {
     if (b == a) continue;
-    const double rb = RangeOf(b);
+    const double rb = bin_range_[b];
     // Beyond ra + support_r: not tested. (Ranges grow with the key: in key order this was where
     // the search stopped, so the same entries are tested in any order.)
     if (rb > ra + support_r) continue;
-    if (std::abs(rb - ra) <= support_r && std::abs(height(b) - ha) >= support_h) return true;
+    if (std::abs(rb - ra) <= support_r && std::abs(bin_height_[b] - ha) >= support_h) return true;
   }
   return false;
 }

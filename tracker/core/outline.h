@@ -47,7 +47,7 @@ class OutlineExtractor {
               const LadarScan& scan, PointSet* out, Eigen::Vector2d* lo,
               Eigen::Vector2d* hi) const;
   // Groups the returns by bearing bin into keys_: bins ascending, a bin's returns in k order
-  // (or by key).
+  // (or by key); bin_runs_ holds each non-empty bin's [begin, end) in keys_.
   void SortByBin(const PointSet& ps, const Eigen::Vector2d& sensor, const Eigen::Vector2d& ref,
                  double bin_rad);
   // Sorts keys_[begin, end), in k order, by key.
@@ -59,10 +59,12 @@ class OutlineExtractor {
   // The entry of the bin keys_[begin, end) PickPerBin takes, or end if none.
   std::size_t PickInBin(const WorldPoints& points, const std::vector<std::int32_t>& idx,
                         std::size_t begin, std::size_t end, double support_height);
-  // Whether another return of the bin within support_range of keys_[a]'s range differs from its
-  // height by support_height or more.
-  bool HasSupport(const WorldPoints& points, const std::vector<std::int32_t>& idx,
-                  std::size_t begin, std::size_t end, std::size_t a, double support_height) const;
+  // Fills bin_range_ and bin_height_ with the range (RangeOf) and height of keys_[begin, end).
+  void LoadBin(const WorldPoints& points, const std::vector<std::int32_t>& idx, std::size_t begin,
+               std::size_t end);
+  // Whether another return of the bin loaded by LoadBin within support_range of the range of
+  // its entry a (from the bin's first) differs from its height by support_height or more.
+  bool HasSupport(std::size_t a, double support_height) const;
   // The largest range span of one ring's returns.
   double LongestRingSpan(const WorldPoints& points, const std::vector<std::int32_t>& idx);
   // Range [m] of keys_[a].
@@ -74,6 +76,9 @@ class OutlineExtractor {
   std::vector<std::pair<std::int64_t, std::int32_t>> sorted_keys_;
   std::vector<std::int64_t> bins_;       // bin of keys_[k]
   std::vector<std::uint32_t> bin_end_;   // counting sort: per bin (from the lowest) its end
+  std::vector<std::pair<std::size_t, std::size_t>> bin_runs_;  // non-empty bins in keys_
+  std::vector<double> bin_range_;        // [m] LoadBin: range of each entry of one bin
+  std::vector<float> bin_height_;        // [m] LoadBin: height of each entry of one bin
   std::vector<float> outline_x_, outline_y_;
   struct RingSpan {
     std::int16_t ring;

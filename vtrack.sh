@@ -23,7 +23,7 @@ pkgs_build=(g++ make cmake pkg-config lld
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev
   libgtest-dev libbenchmark-dev default-jdk-headless)
 pkgs_run=(iproute2 procps zstd tar)
-pkgs_test=(xvfb xauth default-jre libjchart2d-java nftables python3)
+pkgs_test=(xvfb xauth default-jre libjchart2d-java nftables python3 python3-yaml)
 pkgs_bench=(jq)
 pkgs_bench_optional=(libpcl-dev)  # the peer of pcl_bench; without it that comparison is skipped
 pkgs_fuzz=(clang libclang-rt-14-dev)

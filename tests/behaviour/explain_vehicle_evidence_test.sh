@@ -20,6 +20,9 @@ track=$(awk -F, 'NR > 1 && $5 == 1 { n[$2]++ } END { for (t in n) if (n[t] > bes
 cat "$work/out.txt"
 grep -q "^track $track: .* per-scan logit mean" "$work/out.txt"
 [ "$(grep -c '^[a-z_]* *[-+][0-9]' "$work/out.txt")" -ge 3 ] || { echo "fewer than 3 features explained" >&2; exit 1; }
+# The contributions add up to the trees' mean logit of the track (rounding only).
+awk '/^expected \+ contributions - mean logit/ { d = $NF; ok = (d < 1e-9 && d > -1e-9) } END { exit !ok }' \
+  "$work/out.txt" || { echo "the contributions do not add up to the logit" >&2; exit 1; }
 sed -E 's/^(  bias_3d: )([-0-9.e]+)/echo "\1$(python3 -c "print(\2 + 0.5)")"/e' "$src/config/tracker.yaml" > "$work/moved.yaml"
 ! cmp -s "$src/config/tracker.yaml" "$work/moved.yaml" || { echo "bias_3d not moved" >&2; exit 1; }
 set +e
@@ -28,5 +31,6 @@ set +e
 rc=$?
 set -e
 cat "$work/err.txt"
-[ "$rc" -eq 1 ] || { echo "a moved bias went unnoticed (exit $rc, not 1)" >&2; exit 1; }
+[ "$rc" -eq 1 ] && grep -q "not the model the tracker ran with" "$work/err.txt" ||
+  { echo "a moved bias went unnoticed (exit $rc, not 1 with the model refused)" >&2; exit 1; }
 echo "explain-vehicle-evidence: logits agree with the tracker's; a moved bias is refused"

@@ -90,7 +90,9 @@ void OutlineExtractor::SortByBin(const PointSet& ps, const Eigen::Vector2d& s,
     const double v = std::clamp(t, -kMaxTan, kMaxTan) * inv_res;
     auto bin = static_cast<std::int64_t>(v);  // rounds towards zero
     if (static_cast<double>(bin) > v) --bin;
-    const auto r2 = static_cast<std::int64_t>((dx * dx + dy * dy) * 1e4);  // [cm^2]
+    // [cm^2], below 2^32 so that it cannot reach into the bin's part of the key: returns beyond
+    // 655 m (max_range allows 1000 m) are ordered as if at 655 m, by k among themselves.
+    const auto r2 = std::min(static_cast<std::int64_t>((dx * dx + dy * dy) * 1e4), kBinScale - 1);
     keys_[k] = {bin * kBinScale + r2, static_cast<std::int32_t>(k)};
     bins_[k] = bin;
     bin_lo = std::min(bin_lo, bin);

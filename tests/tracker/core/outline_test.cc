@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "base/angle.h"
+#include "tracker/core/outline.h"
 #include "tracker/core/tracker.h"
 
 namespace vtrack {
@@ -113,6 +114,40 @@ TEST(OutlineTest, RingGrazingARoofAtOneRangeMakesNoTrack) {
   TrackerParams loose = NoGroundRemoval();
   loose.outline.arc_span = 0.0;
   EXPECT_NE(Near(RunStill(GrazedRoof(), loose), 6.13, -5.14, 10.0), nullptr);
+}
+
+// A face at the range where the key that orders a bin by range runs out: range^2 in cm^2 is
+// held below 2^32, 655.36 m (max_range allows 1000 m). Two rings 0.5 m apart in height see it,
+// the upper one listed first at 655.45 m (beyond: taken as 655.36 m, not carried into the bin's
+// part of the key), the lower one at 655.30 m. Every bearing bin is on a vertical face, so the
+// outline holds one return per bin, the nearer ring's, none lost or invented.
+TEST(OutlineTest, FaceBeyond655mKeepsOneReturnPerBin) {
+  OutlineParams params;
+  OutlineExtractor extractor(params);
+  WorldPoints pts;
+  LadarScan scan;
+  scan.num_rings = 64;
+  const int columns = 40;
+  for (int ring = 0; ring < 2; ++ring) {
+    for (int c = 0; c < columns; ++c) {
+      const double bearing = DegToRad(0.2 * c + 0.1);  // one column per 0.2 deg bin
+      const double range = ring == 0 ? 655.45 : 655.30;
+      pts.push_back(range * std::cos(bearing), range * std::sin(bearing), ring == 0 ? 1.0f : 0.5f,
+                    static_cast<std::int32_t>(pts.size()), static_cast<std::int16_t>(10 + ring));
+      scan.x.push_back(0.0f);
+      scan.dt_us.push_back(0);
+    }
+  }
+  std::vector<std::int32_t> idx(pts.size());
+  for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = static_cast<std::int32_t>(i);
+  PointSet out;
+  extractor.Extract(pts, idx, scan, Eigen::Vector2d::Zero(), &out);
+  ASSERT_EQ(out.size(), static_cast<std::size_t>(columns));
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    const double x = out.x[k] + out.origin.x(), y = out.y[k] + out.origin.y();
+    EXPECT_TRUE(std::isfinite(x) && std::isfinite(y));
+    EXPECT_NEAR(std::hypot(x, y), 655.30, 0.01) << "entry " << k;  // the lower ring's return
+  }
 }
 
 }  // namespace

@@ -89,9 +89,11 @@ void FrameAssembler::Reset() {
   truth_trails_.clear();
 }
 
-void FrameAssembler::Trigger(std::int64_t utime) {
+void FrameAssembler::Trigger(std::int64_t utime, bool by_tracks) {
   if (last_emitted_ >= 0 && utime <= last_emitted_) {
-    if (utime < last_emitted_) ++stats_.late_dropped;
+    // Equal utimes are one frame: a scan is then already in it, but a TRACKS message that came
+    // after that frame went out without it is never drawn, and is counted as such.
+    if (utime < last_emitted_ || (by_tracks && !last_emitted_had_tracks_)) ++stats_.late_dropped;
     return;
   }
   const auto [it, inserted] = pending_.try_emplace(utime);
@@ -125,7 +127,7 @@ void FrameAssembler::AddScan(std::shared_ptr<const vtrack::ladar_scan_t> scan) {
       last_tracks_clock_ < 0 || clock_ - last_tracks_clock_ > params_.auto_idle_us;
   if (params_.trigger == AssemblerParams::Trigger::kScans ||
       (params_.trigger == AssemblerParams::Trigger::kAuto && tracks_quiet)) {
-    Trigger(scan->utime);
+    Trigger(scan->utime, false);
   }
   Prune();
 }
@@ -154,7 +156,7 @@ void FrameAssembler::AddTracks(std::shared_ptr<const vtrack::track_list_t> track
   for (const auto& t : tracks->tracks) {
     AppendIncreasing(&track_trails_[t.id], tracks->utime, Eigen::Vector2d(t.x, t.y));
   }
-  if (params_.trigger != AssemblerParams::Trigger::kScans) Trigger(tracks->utime);
+  if (params_.trigger != AssemblerParams::Trigger::kScans) Trigger(tracks->utime, true);
   Prune();
 }
 
@@ -257,15 +259,20 @@ FrameInputs FrameAssembler::Make(std::int64_t utime) const {
   return f;
 }
 
+FrameInputs FrameAssembler::Emit(std::int64_t utime) {
+  FrameInputs f = Make(utime);
+  last_emitted_ = utime;
+  last_emitted_had_tracks_ = f.tracks && f.tracks->utime == utime;
+  ++stats_.frames;
+  return f;
+}
+
 std::vector<FrameInputs> FrameAssembler::TakeReady() {
   std::vector<FrameInputs> out = std::move(ready_);
   ready_.clear();
   while (!pending_.empty() && pending_.begin()->second.deadline <= clock_) {
-    const std::int64_t t = pending_.begin()->first;
-    out.push_back(Make(t));
+    out.push_back(Emit(pending_.begin()->first));
     pending_.erase(pending_.begin());
-    last_emitted_ = t;
-    ++stats_.frames;
   }
   return out;
 }
@@ -273,11 +280,7 @@ std::vector<FrameInputs> FrameAssembler::TakeReady() {
 std::vector<FrameInputs> FrameAssembler::Flush() {
   std::vector<FrameInputs> out = std::move(ready_);
   ready_.clear();
-  for (const auto& [t, p] : pending_) {
-    out.push_back(Make(t));
-    last_emitted_ = t;
-    ++stats_.frames;
-  }
+  for (const auto& [t, p] : pending_) out.push_back(Emit(t));
   pending_.clear();
   return out;
 }

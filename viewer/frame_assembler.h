@@ -77,7 +77,9 @@ struct FrameInputs {
 
 struct AssemblerStats {
   std::int64_t frames = 0;          // frames handed out
-  std::int64_t late_dropped = 0;    // triggers that came after a later frame was handed out
+  std::int64_t late_dropped = 0;    // triggers that came after a later frame was handed out, and
+                                    // TRACKS messages after their own utime's frame went out
+                                    // without them (kAuto: a scan frame, the tracker slow)
   std::int64_t resets = 0;          // time jumped back
   std::int64_t poses_refused = 0;   // out of order, repeated or invalid poses
 };
@@ -113,11 +115,12 @@ class FrameAssembler {
     std::int64_t deadline = 0;  // [us] data clock at which the frame is complete
   };
   void Advance(std::int64_t utime);
-  void Trigger(std::int64_t utime);
+  void Trigger(std::int64_t utime, bool by_tracks);
   void CheckJumpBack(std::int64_t utime, std::int64_t* last_of_stream);
   void Reset();
   void Prune();
   FrameInputs Make(std::int64_t utime) const;
+  FrameInputs Emit(std::int64_t utime);  // Make, and remember it as the last handed out
   static std::vector<Eigen::Vector2d> Window(const TimedPath& path, std::int64_t from,
                                              std::int64_t to);
 
@@ -128,6 +131,7 @@ class FrameAssembler {
   std::int64_t last_pose_utime_ = 0;
   std::int64_t last_tracks_clock_ = -1;    // data clock when TRACKS last came; -1 never
   std::int64_t last_emitted_ = -1;         // utime of the last frame handed out; -1 none
+  bool last_emitted_had_tracks_ = false;   // that frame showed the TRACKS message of its utime
   bool has_origin_ = false;
   std::int64_t origin_ = 0;
 

@@ -115,6 +115,10 @@ LiveStats LiveRenderer::stats() const {
   s.frames_rendered = frames_rendered_;
   s.frames_skipped = frames_skipped_;
   s.frames_dropped = slot_.dropped();
+  s.late_dropped = assembler_.stats().late_dropped;
+  if (const auto it = router_.received().find(job_.channels.tracks); it != router_.received().end()) {
+    s.tracks_received = it->second;
+  }
   s.decode_errors = router_.total_decode_errors();
   for (const auto& [channel, n] : router_.received()) s.messages += n;
   return s;

@@ -286,10 +286,13 @@ int main(int argc, char** argv) {
       const auto s = live.stats();
       std::fprintf(stderr,
                    "vtrack-render: %lld frames rendered, %lld dropped (renderer behind), %lld "
-                   "outside --start/--end; %lld decode errors\n",
+                   "outside --start/--end; %lld %s messages received, %lld of them too late to "
+                   "draw in order; %lld decode errors\n",
                    static_cast<long long>(s.frames_rendered),
                    static_cast<long long>(s.frames_dropped),
                    static_cast<long long>(s.frames_skipped),
+                   static_cast<long long>(s.tracks_received), job.channels.tracks.c_str(),
+                   static_cast<long long>(s.late_dropped),
                    static_cast<long long>(s.decode_errors));
       if (live.failed()) throw std::runtime_error(live.error());
       if (!lcm_ok) throw std::runtime_error("LCM reported an error while handling messages");

@@ -188,6 +188,34 @@ TEST(FrameAssemblerTest, TracksTooLateAreDroppedAndCountedNotReordered) {
   for (std::size_t i = 1; i < utimes.size(); ++i) EXPECT_GT(utimes[i], utimes[i - 1]);
 }
 
+// Live, a tracker started late (or restarted) answers scans that have already been drawn as scan
+// frames (kAuto): the answer to the last drawn scan is never drawn either, and is counted.
+TEST(FrameAssemblerTest, TracksForAScanFrameAlreadyHandedOutAreCountedLate) {
+  AssemblerParams p = Params(AssemblerParams::Trigger::kAuto);
+  p.lag_us = 200'000;
+  FrameAssembler a(p);
+  std::vector<FrameInputs> frames;
+  const auto take = [&] {
+    for (auto& f : a.TakeReady()) frames.push_back(std::move(f));
+  };
+  for (int k = 0; k < 15; ++k) {  // no tracker yet: a frame per scan
+    a.AddScan(Share(EmptyScan(1'000'000 + k * kPeriod, k)));
+    take();
+  }
+  // Handed out: the scans up to 12 (scan 14's time is 12's plus the lag).
+  ASSERT_EQ(frames.size(), 13u);
+  ASSERT_EQ(frames.back().utime, 1'000'000 + 12 * kPeriod);
+  a.AddTracks(Share(TrackList(1'000'000 + 12 * kPeriod, 12, {})));  // after its frame
+  a.AddTracks(Share(TrackList(1'000'000 + 13 * kPeriod, 13, {})));  // its frame still pending
+  take();
+  for (auto& f : a.Flush()) frames.push_back(std::move(f));
+  EXPECT_EQ(a.stats().late_dropped, 1);
+  ASSERT_EQ(frames.size(), 15u);
+  EXPECT_FALSE(frames[12].tracks);
+  ASSERT_TRUE(frames[13].tracks);
+  EXPECT_EQ(frames[13].tracks->utime, 1'000'000 + 13 * kPeriod);
+}
+
 // The blue path of a track is the positions the tracker reported before, within trail_s.
 TEST(FrameAssemblerTest, TrailsAreTheEarlierReportedPositions) {
   AssemblerParams p = Params(AssemblerParams::Trigger::kTracks);

@@ -155,6 +155,31 @@ TEST(LiveRendererTest, SlowRendererDropsFramesAndNeverBlocksTheBus) {
   EXPECT_EQ(drawn[1], ego.t0 + (kScans - 1) * kPeriod);
 }
 
+// Every TRACKS message is accounted for: drawn, replaced before it could be drawn, or too late to
+// be drawn in order (a tracker that fell behind, or was restarted).
+TEST(LiveRendererTest, TracksTooLateToDrawAreCounted) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  LiveRenderer r(&lcm, SmallJob(), [](const Scene&, const cv::Mat&) {}, kNoIdleFlush);
+  const EgoArc ego;
+  constexpr int kScans = 10;
+  for (int k = 0; k < kScans; ++k) {
+    const std::int64_t t = ego.t0 + k * kPeriod;
+    for (std::int64_t p = t; p < t + kPeriod; p += 20'000) Publish(lcm, "EGO_POSE", ego.Pose(p));
+    Publish(lcm, "LADAR_SCAN", testing::ScanOf(ego, t, k, {{10.0, 5.0, 0.0}}, {0}));
+    if (k != 3) Publish(lcm, "TRACKS", TrackList(t, k, {TrackAt(1, 10.0 + k, 0.0, 0.0)}));
+  }
+  // The answer to scan 3 after the frames of scans 4-6 have gone out.
+  Publish(lcm, "TRACKS", TrackList(ego.t0 + 3 * kPeriod, 3, {TrackAt(1, 13.0, 0.0, 0.0)}));
+  Drain(r);
+  r.Finish();
+  const LiveStats s = r.stats();
+  EXPECT_EQ(s.tracks_received, kScans);
+  EXPECT_EQ(s.late_dropped, 1);
+  EXPECT_EQ(s.frames_rendered + s.frames_dropped, kScans - 1);
+  EXPECT_EQ(s.frames_rendered + s.frames_dropped + s.late_dropped, s.tracks_received);
+}
+
 TEST(LiveRendererTest, AFailingSinkStopsRenderingWithItsError) {
   lcm::LCM lcm("memq://");
   LiveRenderer r(

@@ -36,7 +36,14 @@ LiveRenderer::LiveRenderer(lcm::LCM* lcm, const RenderJob& job, Sink sink,
       pattern += c;
     }
     subscriptions_.push_back(lcm_->subscribe(pattern, &LiveRenderer::OnMessage, this));
-    if (ch == &job_.channels.slice) subscriptions_.back()->setQueueCapacity(lcm_util::kSliceQueueCapacity);
+    // LCM drops, uncounted, what is queued beyond 30 messages per subscription by default. The
+    // frames are counted here, not by LCM: small messages get the slices' 3 s of queue (TRACKS
+    // at 10 Hz and poses at 100-200 Hz are kilobytes each). Whole scans and TRACK_DEBUG keep
+    // LCM's 30 (3 s at 10 Hz; a 64-beam scan is 2.8 MB).
+    if (ch == &job_.channels.slice || ch == &job_.channels.tracks || ch == &job_.channels.pose ||
+        ch == &job_.channels.truth) {
+      subscriptions_.back()->setQueueCapacity(lcm_util::kSliceQueueCapacity);
+    }
   }
   render_thread_ = std::thread([this] { RenderLoop(); });
 }

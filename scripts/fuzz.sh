@@ -7,6 +7,11 @@
 # VTRACK_FUZZ_BUILD_DIR: another tree; VTRACK_FUZZ_PREBUILT=1: that tree is configured and built
 # already (CI's sanitizer tree, while its tests run): neither reconfigure nor build it.
 set -euo pipefail
+case "${1:-}" in -h|--help) sed -n '2,8s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
+if [ $# -ne 2 ] || ! [ -d "$1" ] || ! [[ $2 =~ ^[0-9]+$ ]] || [ "$2" -lt 1 ]; then
+  echo "usage: fuzz.sh REPO_DIR SECONDS (a source tree and a whole number of seconds per harness; --help)" >&2
+  exit 2
+fi
 repo=$1; seconds=$2
 bdir=${VTRACK_FUZZ_BUILD_DIR:-$repo/build-fuzz}
 jobs=${VTRACK_JOBS:-2}

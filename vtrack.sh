@@ -163,6 +163,7 @@ case "$cmd" in
     cmake --build "$build_dir" -j "$jobs" --target vtrack_bench_programs
     exec "$here/scripts/bench.sh" "$build_dir" "$@" ;;
   fuzz)
+    case "${1:-}" in -h|--help) exec "$here/scripts/fuzz.sh" --help ;; esac
     install_packages "${pkgs_build[@]}" "${pkgs_fuzz[@]}"
     exec "$here/scripts/fuzz.sh" "$here" "${1:-60}" ;;
   demo)

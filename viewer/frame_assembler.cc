@@ -92,8 +92,11 @@ void FrameAssembler::Reset() {
 void FrameAssembler::Trigger(std::int64_t utime, bool by_tracks) {
   if (last_emitted_ >= 0 && utime <= last_emitted_) {
     // Equal utimes are one frame: a scan is then already in it, but a TRACKS message that came
-    // after that frame went out without it is never drawn, and is counted as such.
-    if (utime < last_emitted_ || (by_tracks && !last_emitted_had_tracks_)) ++stats_.late_dropped;
+    // after that frame went out without it has no frame, and is counted as such.
+    if (utime < last_emitted_ || (by_tracks && !last_emitted_had_tracks_)) {
+      ++stats_.late_dropped;
+      if (by_tracks) ++stats_.late_tracks;
+    }
     return;
   }
   const auto [it, inserted] = pending_.try_emplace(utime);

@@ -80,6 +80,9 @@ struct AssemblerStats {
   std::int64_t late_dropped = 0;    // triggers that came after a later frame was handed out, and
                                     // TRACKS messages after their own utime's frame went out
                                     // without them (kAuto: a scan frame, the tracker slow)
+  std::int64_t late_tracks = 0;     // of late_dropped, the TRACKS messages: no frame of their
+                                    // own (a later scan frame, kAuto, may show them as the
+                                    // newest tracks)
   std::int64_t resets = 0;          // time jumped back
   std::int64_t poses_refused = 0;   // out of order, repeated or invalid poses
 };

@@ -122,7 +122,7 @@ LiveStats LiveRenderer::stats() const {
   s.frames_rendered = frames_rendered_;
   s.frames_skipped = frames_skipped_;
   s.frames_dropped = slot_.dropped();
-  s.late_dropped = assembler_.stats().late_dropped;
+  s.tracks_late = assembler_.stats().late_tracks;
   if (const auto it = router_.received().find(job_.channels.tracks); it != router_.received().end()) {
     s.tracks_received = it->second;
   }

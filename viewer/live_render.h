@@ -32,8 +32,9 @@ struct LiveStats {
   std::int64_t frames_rendered = 0;  // drawn and handed to the sink
   std::int64_t frames_dropped = 0;   // replaced by a newer frame before they could be drawn
   std::int64_t frames_skipped = 0;   // outside [start, end]
-  std::int64_t late_dropped = 0;     // TRACKS too late to be drawn in order (FrameAssembler)
   std::int64_t tracks_received = 0;  // TRACKS messages decoded
+  std::int64_t tracks_late = 0;      // of them, too late for a frame of their own, in order
+                                     // (AssemblerStats::late_tracks)
   std::int64_t decode_errors = 0;
 };
 

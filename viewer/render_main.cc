@@ -292,7 +292,7 @@ int main(int argc, char** argv) {
                    static_cast<long long>(s.frames_dropped),
                    static_cast<long long>(s.frames_skipped),
                    static_cast<long long>(s.tracks_received), job.channels.tracks.c_str(),
-                   static_cast<long long>(s.late_dropped),
+                   static_cast<long long>(s.tracks_late),
                    static_cast<long long>(s.decode_errors));
       if (live.failed()) throw std::runtime_error(live.error());
       if (!lcm_ok) throw std::runtime_error("LCM reported an error while handling messages");

@@ -344,15 +344,14 @@ TEST(TrackerLiveTest, UrbanIntersectionLiveWith64LayerScans) {
   //   vtrack-tracker --input s.lcm --output t.lcm; tracker-eval-scores s.lcm t.lcm
   const EvalResult off = EvaluateTracks(run.sim_log, run.offline);
   std::printf("offline urban_intersection (12 s): %s\n", Summary(off).c_str());
-  EXPECT_EQ(off.due, r.due);
   EXPECT_GE(off.matched + 3, off.due) << (off.misses.empty() ? "" : off.misses.front());
   EXPECT_LE(off.id_switches, 1) << (off.switches.empty() ? "" : off.switches.front());
-  const bool all_scans = st.scans_processed >= 119;
-  if (all_scans) {
+  // Pairs are due at the scans that have TRACKS: a scan lost live is a scan fewer to score.
+  if (st.scans_processed == LastStatus(run.offline).scans_processed) {
     // At most one pair short of offline: the live recording comes in two variants (poses and
     // scans interleave differently on the bus), and on one of them the tracker misses vehicle 4
     // for one scan at t = 6.4 s, offline as live (tracker/README.md, open problems).
-    EXPECT_GE(r.matched + 1, off.matched) << (r.misses.empty() ? "" : r.misses.front());
+    EXPECT_LE(r.due - r.matched, off.due - off.matched + 1) << (r.misses.empty() ? "" : r.misses.front());
     EXPECT_LE(r.id_switches, off.id_switches) << (r.switches.empty() ? "" : r.switches.front());
   } else {
     EXPECT_GE(r.matched * 1000, r.due * 990) << (r.misses.empty() ? "" : r.misses.front());

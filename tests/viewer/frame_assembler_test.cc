@@ -184,6 +184,7 @@ TEST(FrameAssemblerTest, TracksTooLateAreDroppedAndCountedNotReordered) {
   for (const auto& f : a.TakeReady()) utimes.push_back(f.utime);
   for (const auto& f : a.Flush()) utimes.push_back(f.utime);
   EXPECT_EQ(a.stats().late_dropped, 1);
+  EXPECT_EQ(a.stats().late_tracks, 1);
   EXPECT_EQ(utimes.size(), 9u);
   for (std::size_t i = 1; i < utimes.size(); ++i) EXPECT_GT(utimes[i], utimes[i - 1]);
 }
@@ -210,6 +211,7 @@ TEST(FrameAssemblerTest, TracksForAScanFrameAlreadyHandedOutAreCountedLate) {
   take();
   for (auto& f : a.Flush()) frames.push_back(std::move(f));
   EXPECT_EQ(a.stats().late_dropped, 1);
+  EXPECT_EQ(a.stats().late_tracks, 1);
   ASSERT_EQ(frames.size(), 15u);
   EXPECT_FALSE(frames[12].tracks);
   ASSERT_TRUE(frames[13].tracks);

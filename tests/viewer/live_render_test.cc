@@ -175,9 +175,9 @@ TEST(LiveRendererTest, TracksTooLateToDrawAreCounted) {
   r.Finish();
   const LiveStats s = r.stats();
   EXPECT_EQ(s.tracks_received, kScans);
-  EXPECT_EQ(s.late_dropped, 1);
+  EXPECT_EQ(s.tracks_late, 1);
   EXPECT_EQ(s.frames_rendered + s.frames_dropped, kScans - 1);
-  EXPECT_EQ(s.frames_rendered + s.frames_dropped + s.late_dropped, s.tracks_received);
+  EXPECT_EQ(s.frames_rendered + s.frames_dropped + s.tracks_late, s.tracks_received);
 }
 
 TEST(LiveRendererTest, AFailingSinkStopsRenderingWithItsError) {

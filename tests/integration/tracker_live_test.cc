@@ -336,7 +336,7 @@ TEST(TrackerLiveTest, UrbanIntersectionLiveWith64LayerScans) {
   // tracks, below, when nothing was lost); a scan lost on the bus may cost a few pairs and a
   // switch. The tracker: on the lap, every due vehicle tracked and no identity switch, with
   // the slack the start time calls for. The RANSAC draws follow each scan's utime, and the lap
-  // starts at the wall clock: over 30 start times (offline, the same 12 s lap), 29 tracked all
+  // starts at the wall clock: over 100 start times (offline, the same 12 s lap), 99 tracked all
   // 2160 due pairs without a switch; one (start utime 1796326980349029) tracked 2157 with one
   // switch, a parked car 33-39 m away whose young track took a false 1.3 m/s from its first
   // fits and lost it for three scans (tracker/README.md, open problems).

@@ -138,6 +138,7 @@ void LogWriter::Write(std::int64_t timestamp_us, const std::string& channel, con
   if (log_->writeEvent(&ev) != 0) {
     throw std::runtime_error("write to LCM log '" + path_ + "' failed (disk full?)");
   }
+  bytes_written_ += 28 + static_cast<std::int64_t>(channel.size() + size);
 }
 
 }  // namespace vtrack::lcm_util

@@ -89,11 +89,16 @@ class LogWriter {
     Write(timestamp_us, channel, buffer_.data(), static_cast<std::size_t>(n));
   }
   std::int64_t events_written() const { return next_event_; }
+  // Bytes of the events written so far, as the file holds them once flushed: per event the LCM
+  // log header (sync word, event number, timestamp, channel and data lengths: 28 bytes), the
+  // channel name and the data.
+  std::int64_t bytes_written() const { return bytes_written_; }
 
  private:
   std::string path_;
   std::unique_ptr<lcm::LogFile> log_;
   std::int64_t next_event_ = 0;
+  std::int64_t bytes_written_ = 0;
   std::vector<std::uint8_t> buffer_;
 };
 

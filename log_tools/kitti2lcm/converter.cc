@@ -22,6 +22,36 @@ std::string ConvertOptions::Validate() const {
   return os.str();
 }
 
+namespace {
+
+// Where the log goes. Through a symbolic link (a chain of them), to the file it names: the link
+// stays. A file that is not a regular one (/dev/null, a pipe) is written directly: a temporary
+// file moved over it would replace it. A regular file, or none yet, is written next to it as
+// OUT.partial and moved over it when complete, so that a failed conversion leaves no half log.
+struct OutputTarget {
+  fs::path path;
+  bool direct = false;
+};
+
+OutputTarget ResolveOutput(const std::string& out) {
+  OutputTarget t{fs::path(out), false};
+  std::error_code ec;
+  for (int hops = 0; fs::is_symlink(fs::symlink_status(t.path, ec)); ++hops) {
+    if (hops == 40) throw KittiError(out + ": too many levels of symbolic links");
+    const fs::path next = fs::read_symlink(t.path, ec);
+    if (ec) throw KittiError(out + ": cannot read the symbolic link: " + ec.message());
+    t.path = next.is_absolute() ? next : t.path.parent_path() / next;
+  }
+  const fs::file_status st = fs::status(t.path, ec);
+  if (fs::is_directory(st)) {
+    throw KittiError(out + ": is a directory (--out names the log file to write)");
+  }
+  t.direct = fs::exists(st) && !fs::is_regular_file(st);
+  return t;
+}
+
+}  // namespace
+
 ConvertStats ConvertSequence(const Sequence& seq, const ConvertOptions& options,
                              const ConvertProgress& progress) {
   if (const std::string err = options.Validate(); !err.empty()) throw KittiError("bad option: " + err);
@@ -44,7 +74,8 @@ ConvertStats ConvertSequence(const Sequence& seq, const ConvertOptions& options,
   for (std::int64_t t = t0; t <= t1; t += options.pose_period_us) pose_times.insert(t);
   for (int i = first; i <= last; ++i) pose_times.insert(seq.FrameUtime(i));
 
-  const std::string partial = options.out + ".partial";
+  const OutputTarget target = ResolveOutput(options.out);
+  const std::string partial = target.direct ? target.path.string() : target.path.string() + ".partial";
   ConvertStats stats;
   try {
     lcm_util::LogWriter log(partial);
@@ -81,21 +112,24 @@ ConvertStats ConvertSequence(const Sequence& seq, const ConvertOptions& options,
         stats.truth_objects += truth.num_objects;
       }
       ++stats.frames;
-      if (progress) progress(stats.frames, total, static_cast<std::int64_t>(fs::file_size(partial)));
+      stats.bytes = log.bytes_written();
+      if (progress) progress(stats.frames, total, stats.bytes);
     }
     write_poses_until(t1);
+    stats.bytes = log.bytes_written();
   } catch (...) {
     std::error_code ec;
-    fs::remove(partial, ec);
+    if (!target.direct) fs::remove(partial, ec);
     throw;
   }
+  if (target.direct) return stats;
   std::error_code ec;
-  fs::rename(partial, options.out, ec);
+  fs::rename(partial, target.path, ec);
   if (ec) {
+    const std::string why = ec.message();
     fs::remove(partial, ec);
-    throw std::runtime_error("cannot move " + partial + " to " + options.out + ": " + ec.message());
+    throw KittiError("cannot move " + partial + " to " + target.path.string() + ": " + why);
   }
-  stats.bytes = static_cast<std::int64_t>(fs::file_size(options.out));
   return stats;
 }
 

@@ -86,6 +86,23 @@ TEST(LogReaderTest, WholeLogReadsAsLiblcmReadsIt) {
 
 // A data length of 0x7fffffff (liblcm 1.3.1 crashes on it) mid-log: that event is skipped, the
 // rest is read.
+// The writer's byte count is the size of the file it leaves (read back by the file system).
+TEST(LogWriterTest, BytesWrittenIsTheFileSize) {
+  const std::string path = testing::ScratchDir("log_reader") + "/count.lcm";
+  std::int64_t counted = 0;
+  {
+    LogWriter w(path);
+    for (int i = 0; i < 7; ++i) {
+      const std::string data(static_cast<std::size_t>(100 * i), 'x');
+      w.Write(1000 * i, "CHANNEL_" + std::to_string(i), data.data(), data.size());
+    }
+    counted = w.bytes_written();
+    EXPECT_EQ(w.events_written(), 7);
+  }
+  EXPECT_EQ(counted, static_cast<std::int64_t>(Bytes(path).size()));
+  EXPECT_GT(counted, 7 * kHeader + 2100);
+}
+
 TEST(LogReaderTest, ImpossibleLengthIsSkippedToTheNextEvent) {
   const Written w = WriteLog("length.lcm", 10);
   std::string b = Bytes(w.path);

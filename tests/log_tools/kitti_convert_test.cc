@@ -145,6 +145,44 @@ TEST(KittiConvertTest, SyntheticLogHasEveryChannelInTimeOrder) {
 
 // Without scans (--no-scans) a raw sequence is written as the boxes layout is: no LADAR_SCAN,
 // the ground truth stamped with each frame's time (half a sweep after the scan's start).
+
+// --out through a symbolic link writes the file the link names (the link stays); a special file
+// such as /dev/null is written directly, not replaced by a moved file; a directory is refused
+// before anything is converted.
+TEST(KittiConvertTest, OutputThroughLinksAndSpecialFilesIsWrittenNotReplaced) {
+  const SequenceOptions so = WriteSyntheticOptions("kitti_convert_out");
+  const Sequence seq(so);
+  ConvertOptions co;
+  co.out = so.dir + "/direct.lcm";
+  const ConvertStats direct = ConvertSequence(seq, co, nullptr);
+  EXPECT_EQ(direct.bytes, static_cast<std::int64_t>(fs::file_size(co.out)));
+
+  fs::create_directories(so.dir + "/logs");
+  fs::create_symlink("logs/target.lcm", so.dir + "/link.lcm");
+  co.out = so.dir + "/link.lcm";
+  const ConvertStats linked = ConvertSequence(seq, co, nullptr);
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(so.dir + "/link.lcm")));
+  ASSERT_TRUE(fs::is_regular_file(so.dir + "/logs/target.lcm"));
+  EXPECT_EQ(static_cast<std::int64_t>(fs::file_size(so.dir + "/logs/target.lcm")), linked.bytes);
+  EXPECT_EQ(linked.bytes, direct.bytes);
+  EXPECT_FALSE(fs::exists(so.dir + "/logs/target.lcm.partial"));
+  EXPECT_FALSE(fs::exists(so.dir + "/link.lcm.partial"));
+
+  co.out = "/dev/null";
+  EXPECT_EQ(ConvertSequence(seq, co, nullptr).bytes, direct.bytes);
+  EXPECT_TRUE(fs::is_character_file("/dev/null"));
+  EXPECT_FALSE(fs::exists("/dev/null.partial"));
+
+  co.out = so.dir + "/logs";
+  try {
+    ConvertSequence(seq, co, nullptr);
+    ADD_FAILURE() << "a directory as --out was accepted";
+  } catch (const KittiError& e) {
+    EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(fs::is_directory(so.dir + "/logs"));
+  EXPECT_FALSE(fs::exists(so.dir + "/logs.partial"));
+}
 TEST(KittiConvertTest, NoScansStampsTheTruthWithTheFrameTime) {
   SequenceOptions so = WriteSyntheticOptions("kitti_convert_no_scans");
   so.no_scans = true;

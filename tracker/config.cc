@@ -17,11 +17,14 @@ namespace {
   throw std::runtime_error(origin + ": " + key + " " + what);
 }
 
+// The value as written, for an error message: a scalar as is, a list or map in flow style
+// ("[1, 2]", "{a: 1}"), nothing as "".
 std::string Scalar(const YAML::Node& n) {
   if (n.IsScalar()) return n.Scalar();
-  std::ostringstream os;
-  os << YAML::Flow << n;
-  return os.str();
+  if (!n.IsDefined() || n.IsNull()) return "";
+  YAML::Emitter out;  // YAML::Flow is the emitter's manipulator; on a std::ostream it prints a number
+  out << YAML::Flow << n;
+  return out.c_str();
 }
 
 template <class T>

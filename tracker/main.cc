@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -128,19 +129,23 @@ int RunLive(const TrackerParams& params, NodeOptions options, const std::string&
 int RunOffline(const TrackerParams& params, const NodeOptions& options, const std::string& input,
                const std::string& output, double status_period_s, bool quiet) {
   lcm_util::LogReader reader(input);
-  lcm_util::LogWriter writer(output);
+  // The node first: its evidence CSV refused leaves an existing output log as it was.
+  std::unique_ptr<lcm_util::LogWriter> writer;
   TrackerNode node(params, options,
                    [&](std::int64_t t, const std::string& ch, const void* data, std::size_t size) {
-                     writer.Write(t, ch, data, size);
+                     writer->Write(t, ch, data, size);
                    });
+  writer = std::make_unique<lcm_util::LogWriter>(output);
   const auto start = std::chrono::steady_clock::now();
   auto next_progress = start + std::chrono::seconds(2);
   const auto status_period_us = static_cast<std::int64_t>(status_period_s * 1e6);
   std::int64_t last_status = 0;
   std::int64_t events = 0;
+  std::map<std::string, std::int64_t> channels;  // events per channel: what a log held instead
   while (const lcm::LogEvent* ev = reader.Next()) {
     if (lcm_util::StopRequested()) break;
     ++events;
+    ++channels[ev->channel];
     node.Handle(ev->channel, ev->data, static_cast<std::size_t>(ev->datalen));
     const std::int64_t t = node.tracker().latest_utime();
     if (t != 0 && (last_status == 0 || t >= last_status + status_period_us || t < last_status)) {
@@ -169,6 +174,22 @@ int RunOffline(const TrackerParams& params, const NodeOptions& options, const st
   for (int i = 0; i < s.num_reasons; ++i) {
     std::fprintf(stderr, "vtrack-tracker:   rejected %-20s %lld\n", s.reject_reason[i].c_str(),
                  static_cast<long long>(s.reject_count[i]));
+  }
+  // Nothing to track is said: a wrong channel name or input mode gives an empty result otherwise.
+  const bool boxes = params.detections.mode == InputMode::kBoxes;
+  const std::int64_t inputs = boxes ? (channels.count(options.detections_channel)
+                                           ? channels.at(options.detections_channel) : 0)
+                                    : s.scans_received;
+  if (inputs == 0 && !lcm_util::StopRequested()) {
+    std::string seen;
+    for (const auto& [name, n] : channels) {
+      seen += (seen.empty() ? "" : ", ") + name + " (" + std::to_string(n) + ")";
+    }
+    const std::string wanted = boxes ? options.detections_channel
+                                     : options.scan_channel + " or " + options.slice_channel;
+    std::fprintf(stderr, "vtrack-tracker: warning: nothing to track: no %s message in %s (%s)\n",
+                 wanted.c_str(), input.c_str(),
+                 seen.empty() ? "the log holds no message" : ("channels: " + seen).c_str());
   }
   if (reader.damaged()) {
     std::fprintf(stderr, "vtrack-tracker: %s\n", reader.DamageSummary().c_str());
@@ -239,6 +260,8 @@ int main(int argc, char** argv) {
     // ignored and the tracker would go live instead.
     if (!vm.count("help")) lcm_util::RefuseStrayArguments(parsed);
     lcm_util::RefuseEmptyChannels(vm);
+    lcm_util::RefuseOverwritingInputs({{"--input", input}, {"--config", config}},
+                                      {{"--output", output}, {"--evidence-csv", options.evidence_csv}});
   } catch (const po::error& e) {
     std::cerr << "vtrack-tracker: " << e.what() << "\n(see --help)\n";
     return 2;

@@ -221,6 +221,11 @@ int main(int argc, char** argv) {
     if (output.video_path.empty() && output.png_dir.empty()) {
       throw UsageError("nothing to write: give --video FILE.mp4 and/or --png-dir DIR");
     }
+    {
+      std::vector<vtrack::lcm_util::PathArgument> in;
+      for (const std::string& i : inputs) in.push_back({"--input", i});
+      vtrack::lcm_util::RefuseOverwritingInputs(in, {{"--video", output.video_path}});
+    }
     if (!inputs.empty() && vm.count("lcm-url")) {
       throw UsageError("--lcm-url is for live rendering; with --input the logs are read directly");
     }
@@ -297,7 +302,7 @@ int main(int argc, char** argv) {
       if (live.failed()) throw std::runtime_error(live.error());
       if (!lcm_ok) throw std::runtime_error("LCM reported an error while handling messages");
     }
-    if (!output.video_path.empty()) {
+    if (!output.video_path.empty() && sink.video_frames() > 0) {
       std::fprintf(stderr, "vtrack-render: video %s: %lld frames at %.2f fps\n",
                    output.video_path.c_str(), static_cast<long long>(sink.video_frames()),
                    sink.fps());
@@ -305,6 +310,15 @@ int main(int argc, char** argv) {
     if (!output.png_dir.empty()) {
       std::fprintf(stderr, "vtrack-render: %zu PNG snapshots in %s\n", sink.png_paths().size(),
                    output.png_dir.c_str());
+    }
+    if (sink.video_frames() == 0 && sink.png_paths().empty()) {
+      // Not a success: the user asked for images and has none (a window of time past the logs'
+      // end, logs without the trigger channel, a bus on which nothing came).
+      std::fprintf(stderr,
+                   "vtrack-render: nothing written%s: no frame within --start/--end%s\n",
+                   output.video_path.empty() ? "" : (" (no video " + output.video_path + ")").c_str(),
+                   output.png_at_s.empty() ? "" : ", or none at a --png-at time");
+      return 1;
     }
   } catch (const std::exception& e) {
     std::cerr << "vtrack-render: error: " << e.what() << "\n";

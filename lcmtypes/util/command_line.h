@@ -4,9 +4,12 @@
 
 #include <boost/program_options.hpp>
 
+#include <filesystem>
 #include <iostream>
 #include <string>
 #include <typeinfo>
+#include <utility>
+#include <vector>
 
 namespace vtrack::lcm_util {
 
@@ -32,6 +35,55 @@ inline void RefuseEmptyChannels(const boost::program_options::variables_map& vm)
     if (!channel || value.empty() || value.value().type() != typeid(std::string)) continue;
     if (value.as<std::string>().empty()) {
       throw boost::program_options::error("--" + key + " must not be empty");
+    }
+  }
+}
+
+// A file named on the command line: the option that names it ("--output", or "" for a
+// positional argument) and its path.
+struct PathArgument {
+  std::string option;
+  std::string path;
+};
+
+// True if a and b name the same file: the same existing file (a link, a relative and an absolute
+// path, a hard link), or one not there yet named by the same normalised absolute path.
+inline bool SameFile(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  if (std::filesystem::equivalent(a, b, ec) && !ec) return true;
+  const auto normal = [](const std::string& p) {
+    std::error_code e;
+    return std::filesystem::weakly_canonical(std::filesystem::absolute(p, e), e).lexically_normal();
+  };
+  return normal(a) == normal(b);
+}
+
+// Throws boost::program_options::error if an output would overwrite an input or another output
+// (each written over the other: the input lost, or one output cut short), naming both options.
+// Empty paths are not files, and "-" (standard output) or a device such as /dev/null is never one.
+inline void RefuseOverwritingInputs(const std::vector<PathArgument>& inputs,
+                                    const std::vector<PathArgument>& outputs) {
+  const auto name = [](const PathArgument& a) {
+    return (a.option.empty() ? std::string() : a.option + " ") + "'" + a.path + "'";
+  };
+  const auto is_file = [](const std::string& p) {
+    std::error_code ec;
+    const auto st = std::filesystem::status(p, ec);
+    return !p.empty() && p != "-" && (!std::filesystem::exists(st) || std::filesystem::is_regular_file(st));
+  };
+  for (std::size_t o = 0; o < outputs.size(); ++o) {
+    if (!is_file(outputs[o].path)) continue;
+    for (const PathArgument& in : inputs) {
+      if (!in.path.empty() && SameFile(outputs[o].path, in.path)) {
+        throw boost::program_options::error(name(outputs[o]) + " is also the input " + name(in) +
+                                            ": writing it would destroy the input");
+      }
+    }
+    for (std::size_t k = 0; k < o; ++k) {
+      if (is_file(outputs[k].path) && SameFile(outputs[o].path, outputs[k].path)) {
+        throw boost::program_options::error(name(outputs[o]) + " and " + name(outputs[k]) +
+                                            " are the same file: give each output its own");
+      }
     }
   }
 }

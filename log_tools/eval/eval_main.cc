@@ -57,6 +57,12 @@ int main(int argc, char** argv) {
     if (!kitti_out.empty() && eval_opts.kitti_calib.empty()) {
       throw std::invalid_argument("--kitti-out needs --kitti-calib FILE");
     }
+    std::vector<vtrack::lcm_util::PathArgument> inputs{{"--kitti-calib", eval_opts.kitti_calib},
+                                                       {"--kitti-dontcare", eval_opts.kitti_dont_care}};
+    for (const std::string& log : logs) inputs.push_back({"", log});
+    vtrack::lcm_util::RefuseOverwritingInputs(
+        inputs, {{"--json", json_path}, {"--csv", csv_path}, {"--track-labels", labels_path},
+                 {"--kitti-out", kitti_out}});
   } catch (const std::exception& e) {
     std::cerr << "vtrack-eval: " << e.what() << "\n";
     return 2;

@@ -72,6 +72,8 @@ int main(int argc, char** argv) {
     if (!vtrack::lcm_util::StoreCommandLine(po::parse_command_line(argc, argv, desc), desc, &vm)) {
       return 0;
     }
+    vtrack::lcm_util::RefuseOverwritingInputs(
+        {{"--poses", seq_opt.poses_file}, {"--oxts", seq_opt.oxts_file}}, {{"--out", conv.out}});
   } catch (const po::error& e) {
     std::cerr << "vtrack-kitti2lcm: " << e.what() << "\n(see vtrack-kitti2lcm --help)\n";
     return 2;

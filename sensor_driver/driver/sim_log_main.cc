@@ -9,6 +9,7 @@
 #include <iostream>
 
 #include "lcmtypes/util/log_reader.h"
+#include "lcmtypes/util/command_line.h"
 #include "sensor_driver/driver/sim_cli.h"
 #include "sensor_driver/sim/describe.h"
 #include "sensor_driver/sim/sim_log.h"
@@ -37,6 +38,10 @@ int main(int argc, char** argv) {
   auto check = [](const po::variables_map& vm) {
     if (!vm.count("scenario")) throw po::error("--scenario is required");
     if (!vm.count("out") && !vm.count("describe")) throw po::error("--out is required");
+    if (vm.count("out")) {
+      vtrack::lcm_util::RefuseOverwritingInputs({{"--scenario", vm["scenario"].as<std::string>()}},
+                                                {{"--out", vm["out"].as<std::string>()}});
+    }
     vtrack::sim::ReadSweepOutputOptions(vm);
   };
   po::variables_map vm;

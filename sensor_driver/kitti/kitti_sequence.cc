@@ -28,7 +28,14 @@ std::string BinName(int i) {
 // Counts 000000.bin, 000001.bin, ... and checks that they are contiguous from 0.
 int CountFrames(const std::string& dir) {
   std::set<int> indices;
-  for (const auto& e : fs::directory_iterator(dir)) {
+  std::error_code ec;
+  fs::directory_iterator it(dir, ec);
+  if (ec) {
+    throw KittiError("cannot read the Velodyne frames folder '" + dir + "': " + ec.message() +
+                     " (--poses and --oxts need the raw layout's point clouds; a folder of the "
+                     "boxes layout takes its ego motion from ego_pose_orbslam3/ without them)");
+  }
+  for (const auto& e : it) {
     const std::string name = e.path().filename().string();
     if (name.size() != 10 || name.substr(6) != ".bin") continue;
     if (!std::all_of(name.begin(), name.begin() + 6, [](char c) { return c >= '0' && c <= '9'; })) continue;

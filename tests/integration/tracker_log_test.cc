@@ -568,5 +568,56 @@ TEST(TrackerCliTest, StrayArgumentsAndEmptyChannelsAreRefused) {
   }
 }
 
+// An output that names the input, or another output, is refused before anything is written; a
+// refused evidence CSV leaves an existing output log as it was.
+TEST(TrackerCliTest, OutputsThatWouldDestroyAnInputAreRefused) {
+  const std::string dir = ScratchDir("tracker_cli_outputs");
+  const std::string in = dir + "/in.lcm", out = dir + "/out.txt", keep = dir + "/keep.lcm";
+  ASSERT_EQ(RunCommand({Bin("vtrack-sim-log"), "--scenario", "paper_fig4_turn", "--duration", "1",
+                        "--out", in, "-q"}), 0);
+  const std::string original = ReadFile(in);
+  ASSERT_GT(original.size(), 1000u);
+  std::filesystem::remove(dir + "/link.lcm");
+  std::filesystem::create_symlink("in.lcm", dir + "/link.lcm");
+  for (const std::string& o : {in, dir + "/link.lcm", dir + "/../" +
+                                   std::filesystem::path(dir).filename().string() + "/in.lcm"}) {
+    EXPECT_EQ(RunCommand({Bin("vtrack-tracker"), "--input", in, "--output", o}, out,
+                         std::chrono::seconds(30)), 2) << o;
+    EXPECT_NE(ReadFile(out).find("is also the input"), std::string::npos) << ReadFile(out);
+  }
+  EXPECT_EQ(RunCommand({Bin("vtrack-tracker"), "--input", in, "--output", keep, "--evidence-csv",
+                        keep}, out, std::chrono::seconds(30)), 2);
+  EXPECT_NE(ReadFile(out).find("are the same file"), std::string::npos) << ReadFile(out);
+  EXPECT_EQ(ReadFile(in), original);
+  std::ofstream(keep) << "an earlier run's log";
+  EXPECT_EQ(RunCommand({Bin("vtrack-tracker"), "--input", in, "--output", keep, "--evidence-csv",
+                        dir + "/no/such/dir/e.csv"}, out, std::chrono::seconds(30)), 1);
+  EXPECT_NE(ReadFile(out).find("cannot write the evidence CSV"), std::string::npos) << ReadFile(out);
+  EXPECT_EQ(ReadFile(keep), "an earlier run's log");
+}
+
+// A run that finds nothing to track (a wrong channel name, boxes asked of a log without any) says
+// so, with the channels the log holds.
+TEST(TrackerCliTest, NothingToTrackIsSaid) {
+  const std::string dir = ScratchDir("tracker_cli_nothing");
+  const std::string in = dir + "/in.lcm", out = dir + "/out.txt";
+  ASSERT_EQ(RunCommand({Bin("vtrack-sim-log"), "--scenario", "paper_fig4_turn", "--duration", "1",
+                        "--out", in, "-q"}), 0);
+  EXPECT_EQ(RunCommand({Bin("vtrack-tracker"), "--input", in, "--output", dir + "/t.lcm",
+                        "--scan-channel", "LIDAR", "--slice-channel", "LIDAR_SLICE"}, out,
+                       std::chrono::seconds(30)), 0);
+  EXPECT_NE(ReadFile(out).find("nothing to track: no LIDAR or LIDAR_SLICE message"), std::string::npos)
+      << ReadFile(out);
+  EXPECT_NE(ReadFile(out).find("channels: EGO_POSE ("), std::string::npos) << ReadFile(out);
+  EXPECT_NE(ReadFile(out).find("LADAR_SCAN ("), std::string::npos) << ReadFile(out);
+  EXPECT_EQ(RunCommand({Bin("vtrack-tracker"), "--input", in, "--output", dir + "/t.lcm",
+                        "--input-mode", "boxes"}, out, std::chrono::seconds(30)), 0);
+  EXPECT_NE(ReadFile(out).find("nothing to track: no DETECTIONS message"), std::string::npos)
+      << ReadFile(out);
+  EXPECT_EQ(RunCommand({Bin("vtrack-tracker"), "--input", in, "--output", dir + "/t.lcm"}, out,
+                       std::chrono::seconds(30)), 0);
+  EXPECT_EQ(ReadFile(out).find("nothing to track"), std::string::npos) << ReadFile(out);
+}
+
 }  // namespace
 }  // namespace vtrack::testing

@@ -87,6 +87,16 @@ TEST(TrackerConfigTest, DeclaredRangesAreEnforced) {
             std::string::npos);
   EXPECT_NE(ErrorOf("input:\n  max_queued_scans: 2.5\n").find("input.max_queued_scans = '2.5' is not a valid integer"),
             std::string::npos);
+  // A value that is no number, as written: nothing, a list, a map.
+  EXPECT_NE(ErrorOf("preprocess:\n  min_range:\n").find("preprocess.min_range = '' is not a valid number"),
+            std::string::npos)
+      << ErrorOf("preprocess:\n  min_range:\n");
+  EXPECT_NE(ErrorOf("preprocess:\n  min_range: [1, 2]\n").find("preprocess.min_range = '[1, 2]' is not"),
+            std::string::npos)
+      << ErrorOf("preprocess:\n  min_range: [1, 2]\n");
+  EXPECT_NE(ErrorOf("preprocess:\n  min_range: {a: 1}\n").find("preprocess.min_range = '{a: 1}' is not"),
+            std::string::npos)
+      << ErrorOf("preprocess:\n  min_range: {a: 1}\n");
   EXPECT_NE(ErrorOf("detections:\n  gate_m: 9\n").find("detections.gate_m = 9.0 m: must be <= max_gate_m"),
             std::string::npos);
   EXPECT_NE(ErrorOf("preprocess:\n  min_height: .nan\n").find("preprocess.min_height = nan m: must be finite"),

@@ -229,6 +229,15 @@ TEST(RenderLogTest, StartEndAndMaxFrames) {
   r = Render(dir, Cat(Inputs(logs), {"--video", dir + "/m.mp4", "--max-frames", "7"}));
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(DecodedFrames(dir + "/m.mp4"), 7);
+  // A window past the logs' end draws nothing: said, and not a success.
+  r = Render(dir, Cat(Inputs(logs), {"--video", dir + "/late.mp4", "--start", "1000"}));
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("nothing written (no video " + dir + "/late.mp4)"), std::string::npos)
+      << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/late.mp4"));
+  r = Render(dir, Cat(Inputs(logs), {"--png-dir", dir + "/png", "--png-at", "1000"}));
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("or none at a --png-at time"), std::string::npos) << r.output;
 }
 
 TEST(RenderMainTest, HelpAndBadOptions) {

@@ -11,6 +11,8 @@
 #include "lcmtypes/util/text.h"
 #include "base/angle.h"
 #include "base/pose.h"
+#include "vtrack/detection_list_t.hpp"
+#include "vtrack/detection_t.hpp"
 #include "vtrack/hypothesis_t.hpp"
 #include "vtrack/ladar_scan_t.hpp"
 #include "vtrack/ladar_slice_t.hpp"
@@ -76,6 +78,20 @@ std::string Summarise(const track_list_t& m) {
                 LL(m.scan_seq), m.latency_us * 1e-3);
 }
 
+std::string Summarise(const detection_list_t& m) {
+  double best = -std::numeric_limits<double>::infinity();
+  for (const auto& b : m.detections) best = std::max(best, static_cast<double>(b.score));
+  return m.num_detections == 0
+             ? Format("%s: no boxes, frame %lld", m.source.c_str(), LL(m.seq))
+             : Format("%s: %d boxes (best score %.2f), frame %lld", m.source.c_str(),
+                      m.num_detections, best, LL(m.seq));
+}
+
+std::string Summarise(const detection_t& m) {
+  return Format("box class %d at (%.2f, %.2f) m, %.2f x %.2f m, score %.2f", m.object_class, m.x,
+                m.y, m.length, m.width, m.score);
+}
+
 std::string Summarise(const track_debug_t& m) {
   return Format("scan %lld: %d segments, %d track entries", LL(m.scan_seq), m.num_segments,
                 m.num_entries);
@@ -139,7 +155,8 @@ const std::vector<KnownType>& KnownTypes() {
       {object_list_t::getHash(), "object_list_t"},   {track_list_t::getHash(), "track_list_t"},
       {track_debug_t::getHash(), "track_debug_t"},   {tracker_status_t::getHash(), "tracker_status_t"},
       {object_t::getHash(), "object_t"},             {track_t::getHash(), "track_t"},
-      {hypothesis_t::getHash(), "hypothesis_t"},     {track_debug_entry_t::getHash(), "track_debug_entry_t"}};
+      {hypothesis_t::getHash(), "hypothesis_t"},     {track_debug_entry_t::getHash(), "track_debug_entry_t"},
+      {detection_list_t::getHash(), "detection_list_t"}, {detection_t::getHash(), "detection_t"}};
   return types;
 }
 
@@ -177,7 +194,9 @@ Description Describe(const void* data, std::size_t size) {
       TryDescribe<object_t>(data, size, fp, "object_t", &d) ||
       TryDescribe<track_t>(data, size, fp, "track_t", &d) ||
       TryDescribe<hypothesis_t>(data, size, fp, "hypothesis_t", &d) ||
-      TryDescribe<track_debug_entry_t>(data, size, fp, "track_debug_entry_t", &d)) {
+      TryDescribe<track_debug_entry_t>(data, size, fp, "track_debug_entry_t", &d) ||
+      TryDescribe<detection_list_t>(data, size, fp, "detection_list_t", &d) ||
+      TryDescribe<detection_t>(data, size, fp, "detection_t", &d)) {
     return d;
   }
   d.type = Format("? 0x%016llx", static_cast<unsigned long long>(fp));

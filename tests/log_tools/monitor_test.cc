@@ -11,6 +11,7 @@
 #include "tests/log_tools/synthetic_run.h"
 #include "tests/support/subprocess.h"
 #include "tests/support/test_env.h"
+#include "vtrack/detection_list_t.hpp"
 #include "vtrack/pose_t.hpp"
 #include "vtrack/tracker_status_t.hpp"
 
@@ -71,6 +72,22 @@ TEST(MonitorTest, DescribesEachType) {
   d = Describe(sb.data(), sb.size());
   EXPECT_NE(d.summary.find("scans 10 recv / 9 proc / 1 drop"), std::string::npos) << d.summary;
   EXPECT_NE(d.summary.find("nan_point 4"), std::string::npos) << d.summary;
+
+  vtrack::detection_list_t boxes{};
+  boxes.seq = 17;
+  boxes.source = "pointrcnn";
+  boxes.num_detections = 2;
+  boxes.detections.resize(2);
+  boxes.detections[0].score = 0.5f;
+  boxes.detections[1].score = 0.75f;
+  for (auto& b : boxes.detections) b.length = b.width = b.height = 1.0;
+  const std::string db = Encode(boxes);
+  d = Describe(db.data(), db.size());
+  EXPECT_TRUE(d.ok);
+  EXPECT_EQ(d.type, "detection_list_t");
+  EXPECT_NE(d.summary.find("pointrcnn: 2 boxes (best score 0.75), frame 17"), std::string::npos)
+      << d.summary;
+  EXPECT_EQ(TypeName(vtrack::detection_list_t::getHash()), "detection_list_t");
 }
 
 TEST(MonitorTest, BadMessagesSayWhy) {

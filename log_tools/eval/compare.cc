@@ -315,6 +315,23 @@ int RunCompare(const CompareOptions& o) {
   };
 
   // Work directory.
+  // The outputs first: a --json or --plots that cannot be written is said before any run, not
+  // after all of them.
+  if (!o.plots_dir.empty()) {
+    std::error_code ec;
+    fs::create_directories(o.plots_dir, ec);
+    if (!fs::is_directory(o.plots_dir)) {
+      throw std::runtime_error("cannot create --plots directory '" + o.plots_dir + "'");
+    }
+  }
+  if (!o.json_path.empty()) {
+    const bool existed = fs::exists(o.json_path);
+    if (!std::ofstream(o.json_path, std::ios::app)) {
+      throw std::runtime_error("cannot write --json '" + o.json_path + "'");
+    }
+    std::error_code ec;
+    if (!existed) fs::remove(o.json_path, ec);
+  }
   std::string work = o.work_dir;
   bool temporary = false;
   if (work.empty()) {
@@ -326,13 +343,6 @@ int RunCompare(const CompareOptions& o) {
     std::error_code ec;
     fs::create_directories(work, ec);
     if (!fs::is_directory(work)) throw std::runtime_error("cannot create --work-dir '" + work + "'");
-  }
-  if (!o.plots_dir.empty()) {
-    std::error_code ec;
-    fs::create_directories(o.plots_dir, ec);
-    if (!fs::is_directory(o.plots_dir)) {
-      throw std::runtime_error("cannot create --plots directory '" + o.plots_dir + "'");
-    }
   }
 
   lcm_util::InstallStopHandlers();
@@ -584,7 +594,12 @@ int RunCompare(const CompareOptions& o) {
       w.EndObject();
     }
     w.EndObject();
-    WriteTextFile(o.json_path, w.str() + "\n");
+    try {
+      WriteTextFile(o.json_path, w.str() + "\n");
+    } catch (const std::exception&) {
+      if (temporary) std::fprintf(stderr, "work directory kept: %s\n", work.c_str());
+      throw;
+    }
     std::fprintf(stderr, "wrote %s\n", o.json_path.c_str());
   }
 

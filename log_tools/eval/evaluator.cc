@@ -329,13 +329,19 @@ LogData LoadLogs(const std::vector<std::string>& paths, const EvalParams& params
 }
 
 std::string SelectMode(const LogData& data, const EvalParams& params) {
+  // "; N of them undecodable" where the channel's messages were there but none could be read.
+  const auto undecodable = [&](const std::string& channel) {
+    const auto it = data.problems.find("decode_error_" + channel);
+    return it == data.problems.end() ? std::string()
+                                     : ": " + std::to_string(it->second) + " messages on it could not be decoded";
+  };
   if (data.truth.empty()) {
     throw std::runtime_error("no ground truth (object_list_t on channel '" + params.truth_channel +
-                             "') in the logs");
+                             "') in the logs" + undecodable(params.truth_channel));
   }
   if (data.tracks.empty()) {
     throw std::runtime_error("no tracks (track_list_t on channel '" + params.tracks_channel +
-                             "') in the logs");
+                             "') in the logs" + undecodable(params.tracks_channel));
   }
   if (!params.mode.empty()) {
     if (!data.tracks.count(params.mode)) {

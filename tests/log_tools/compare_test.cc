@@ -63,6 +63,19 @@ TEST_F(CompareTest, HelpAndBadOptions) {
   EXPECT_EQ(RunTool({"--scenarios", "a", "--bin-dir", dir_ + "/nowhere"}, &out, {"TMPDIR=" + dir_}),
             1);
   EXPECT_NE(out.find("vtrack-sim-log"), std::string::npos) << out;
+  // Outputs that cannot be written are said before any run, and leave no work directory.
+  const std::string tmp = dir_ + "/tmp_outputs";
+  fs::create_directories(tmp);
+  EXPECT_EQ(RunTool({"--scenarios", "a", "--bin-dir", fake_bin_, "--json", dir_ + "/no/such/dir/c.json"},
+                    &out, {"TMPDIR=" + tmp}), 1);
+  EXPECT_NE(out.find("cannot write --json '" + dir_ + "/no/such/dir/c.json'"), std::string::npos) << out;
+  EXPECT_EQ(out.find("[1/"), std::string::npos) << "a run started: " << out;
+  std::ofstream(dir_ + "/a_file") << "x";
+  EXPECT_EQ(RunTool({"--scenarios", "a", "--bin-dir", fake_bin_, "--plots", dir_ + "/a_file/plots"},
+                    &out, {"TMPDIR=" + tmp}), 1);
+  EXPECT_NE(out.find("cannot create --plots directory"), std::string::npos) << out;
+  EXPECT_TRUE(fs::is_empty(tmp)) << "a temporary work directory was left in " << tmp;
+  EXPECT_FALSE(fs::exists(dir_ + "/no"));
 }
 
 TEST_F(CompareTest, ThreeModesOnTwoScenariosAndKitti) {

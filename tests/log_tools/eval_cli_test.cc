@@ -100,6 +100,15 @@ TEST_F(EvalCliTest, HelpAndBadOptions) {
   EXPECT_NE(out.find("missing.lcm"), std::string::npos) << out;
   EXPECT_EQ(RunTool({run_}, &out), 1);  // no tracks in it
   EXPECT_NE(out.find("no tracks"), std::string::npos) << out;
+  // Ground truth whose every message is damaged: there, but unreadable, and said so.
+  const std::string damaged = dir_ + "/damaged_truth.lcm";
+  {
+    lcm_util::LogWriter w(damaged);
+    for (int k = 0; k < 3; ++k) w.Write(1000 * k, "GROUND_TRUTH", "not an object list", 18);
+  }
+  EXPECT_EQ(RunTool({damaged, tracks_}, &out), 1);
+  EXPECT_NE(out.find("no ground truth (object_list_t on channel 'GROUND_TRUTH') in the logs: 3 "
+                     "messages on it could not be decoded"), std::string::npos) << out;
 }
 
 TEST_F(EvalCliTest, WritesJsonCsvAndPlots) {

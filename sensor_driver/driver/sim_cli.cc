@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <type_traits>
 
+#include "base/pose.h"
 #include "lcmtypes/util/command_line.h"
 
 namespace vtrack::sim {
@@ -89,8 +90,9 @@ SimCli ReadSimCli(const po::variables_map& vm) {
   if (vm.count("scenario")) c.scenario = vm["scenario"].as<std::string>();
   get("duration", &c.duration);
   get("start-utime", &c.start_utime);
-  if (c.start_utime && *c.start_utime < 0) {
-    throw po::error("--start-utime = " + std::to_string(*c.start_utime) + ": must be >= 0");
+  if (c.start_utime && (*c.start_utime < 0 || *c.start_utime > vtrack::kMaxStartUtime)) {
+    throw po::error("--start-utime = " + std::to_string(*c.start_utime) + ": must be in [0, " +
+                    std::to_string(vtrack::kMaxStartUtime) + "] us (2^53: the year 2255)");
   }
   get("seed", &c.run.seed);
   if (vm.count("sensor")) c.run.sensor = vm["sensor"].as<std::string>();

@@ -247,6 +247,15 @@ TEST(SimLogTest, CommandLineErrorsAreClear) {
   EXPECT_NE(ReadFile(dir + "/bad.txt").find("ego.start.yy: unknown key"), std::string::npos);
   EXPECT_EQ(SimLog({"--scenario", "stress", "--out", "/nonexistent/dir/x.lcm"}, dir + "/out.txt"), 1);
   EXPECT_NE(ReadFile(dir + "/out.txt").find("/nonexistent/dir/x.lcm"), std::string::npos);
+  // A start time past 2^53 us would overflow the log's times a few seconds in: refused.
+  EXPECT_EQ(SimLog({"--scenario", "stress", "--out", dir + "/x.lcm", "--start-utime",
+                    "9223372036854775807"}, dir + "/late.txt"), 2);
+  EXPECT_NE(ReadFile(dir + "/late.txt").find("--start-utime = 9223372036854775807: must be in [0, "),
+            std::string::npos) << ReadFile(dir + "/late.txt");
+  // The log must not overwrite its scenario.
+  EXPECT_EQ(SimLog({"--scenario", dir + "/bad.yaml", "--out", dir + "/bad.yaml"}, dir + "/self.txt"), 2);
+  EXPECT_NE(ReadFile(dir + "/self.txt").find("is also the input --scenario"), std::string::npos)
+      << ReadFile(dir + "/self.txt");
   EXPECT_EQ(SimLog({"--scenario", "urban_intersection", "--describe"}, dir + "/describe.txt"), 0);
   EXPECT_NE(ReadFile(dir + "/describe.txt").find("no overlapping footprints"), std::string::npos);
 }

@@ -24,8 +24,12 @@ std::uint64_t BigEndian(const unsigned char* p, int n) {
 
 LogReader::LogReader(const std::string& path) : path_(path) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    throw std::runtime_error("cannot open LCM log '" + path + "': no such file");
+  const std::filesystem::file_status st = std::filesystem::status(path, ec);
+  if (!std::filesystem::is_regular_file(st)) {
+    throw std::runtime_error("cannot open LCM log '" + path + "': " +
+                             (!std::filesystem::exists(st)       ? "no such file"
+                              : std::filesystem::is_directory(st) ? "a directory, not a log file"
+                                                                  : "not a regular file"));
   }
   file_size_ = static_cast<std::int64_t>(std::filesystem::file_size(path, ec));
   file_ = std::fopen(path.c_str(), "rb");

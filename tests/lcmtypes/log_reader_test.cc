@@ -103,6 +103,21 @@ TEST(LogWriterTest, BytesWrittenIsTheFileSize) {
   EXPECT_GT(counted, 7 * kHeader + 2100);
 }
 
+// What is not a log is said for what it is.
+TEST(LogReaderTest, AMissingFileOrADirectoryIsNamed) {
+  const std::string dir = testing::ScratchDir("log_reader");
+  const auto message = [](const std::string& path) {
+    try {
+      LogReader r(path);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(message(dir + "/missing.lcm"), "cannot open LCM log '" + dir + "/missing.lcm': no such file");
+  EXPECT_EQ(message(dir), "cannot open LCM log '" + dir + "': a directory, not a log file");
+}
+
 TEST(LogReaderTest, ImpossibleLengthIsSkippedToTheNextEvent) {
   const Written w = WriteLog("length.lcm", 10);
   std::string b = Bytes(w.path);

@@ -224,6 +224,10 @@ std::vector<KittiObject> ReadTrackingFile(const std::string& path, bool is_resul
       continue;
     }
     if (o.track_id == -1 && o.type != ObjectType::kDontCare) continue;
+    if (o.type != ObjectType::kDontCare && !(o.box.h > 0.0 && o.box.w > 0.0 && o.box.l > 0.0)) {
+      throw std::runtime_error(where + ": a " + f[2] + "'s box needs h, w and l > 0, got " + f[10] +
+                               " " + f[11] + " " + f[12]);
+    }
     if (is_result && !seen.emplace(o.frame, o.track_id).second) {
       throw std::runtime_error(where + ": track id " + std::to_string(o.track_id) +
                                " occurs twice in frame " + std::to_string(o.frame));

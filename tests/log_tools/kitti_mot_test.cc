@@ -199,6 +199,8 @@ TEST(KittiMotFiles, ReadsClassesAndRejectsMalformedLines) {
   s.replace(s.find("Car 0 0 -1"), 10, "Car 0 0 xx");
   expect_error(s, "bad.txt:1: alpha 'xx'");
   expect_error("1.5 2 Car 0 0 -1 0 0 1 1 1 1 1 0 0 0 0 1\n", "bad.txt:1: frame '1.5'");
+  expect_error("0 2 Car 0 0 -1 0 0 1 1 1.5 -1.8 4 0 0 0 0 1\n",
+               "bad.txt:1: a Car's box needs h, w and l > 0, got 1.5 -1.8 4");
   try {
     ReadTrackingFile(dir + "/missing.txt", false);
     ADD_FAILURE();

@@ -808,9 +808,11 @@ LadarParams Scenario::Sensor(const std::string& which) const {
   if (auto it = sensors.find(n); it != sensors.end()) return it->second;
   LadarParams p;
   if (LadarPreset(n, &p)) return p;
+  std::set<std::string> available;  // the scenario's sensors and the presets, once each
+  for (const auto& kv : sensors) available.insert(kv.first);
+  for (const auto& s : LadarPresetNames()) available.insert(s);
   std::string names;
-  for (const auto& kv : sensors) names += (names.empty() ? "" : ", ") + kv.first;
-  for (const auto& s : LadarPresetNames()) names += (names.empty() ? "" : ", ") + s;
+  for (const auto& s : available) names += (names.empty() ? "" : ", ") + s;
   throw std::invalid_argument("no sensor '" + n + "' in scenario '" + name + "'; available: " +
                               names);
 }

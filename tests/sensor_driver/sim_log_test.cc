@@ -241,6 +241,11 @@ TEST(SimLogTest, CommandLineErrorsAreClear) {
   EXPECT_NE(ReadFile(dir + "/drop.txt").find("dropout = 1.5"), std::string::npos);
   EXPECT_EQ(SimLog({"--scenario", "stress", "--out", dir + "/x.lcm", "--sensor", "lidar9"}, dir + "/sensor.txt"), 1);
   EXPECT_NE(ReadFile(dir + "/sensor.txt").find("no sensor 'lidar9'"), std::string::npos);
+  // Each available sensor named once (the scenario's own and the presets overlap).
+  const std::string sensors = ReadFile(dir + "/sensor.txt");
+  const auto first = sensors.find("velodyne64");
+  ASSERT_NE(first, std::string::npos) << sensors;
+  EXPECT_EQ(sensors.find("velodyne64", first + 1), std::string::npos) << sensors;
   std::ofstream(dir + "/bad.yaml") << "duration: 10\nsensor: single_plane\nego:\n  start: {x: 0, yy: 0}\n";
   EXPECT_EQ(SimLog({"--scenario", dir + "/bad.yaml", "--out", dir + "/x.lcm"}, dir + "/bad.txt"), 1);
   EXPECT_NE(ReadFile(dir + "/bad.txt").find(dir + "/bad.yaml:4:"), std::string::npos) << ReadFile(dir + "/bad.txt");

@@ -34,7 +34,15 @@ KittiScanTimeline::KittiScanTimeline(kitti::SequenceOptions options, lcm::LCM* l
     : KittiTimeline(std::move(options), lcm),
       output_(std::move(output)),
       truth_channel_(std::move(truth_channel)),
-      detections_channel_(std::move(detections_channel)) {}
+      detections_channel_(std::move(detections_channel)) {
+  // Refused before the first lap, not at its first scan: a folder of the boxes layout has no
+  // point clouds to publish (vtrack-ego-pose takes it; its boxes come with vtrack-kitti2lcm).
+  if (!seq().has_scans()) {
+    throw kitti::KittiError(seq().options().dir + ": sequence " + seq().sequence() +
+                            " has no Velodyne point clouds (the boxes layout): nothing to publish "
+                            "as scans");
+  }
+}
 
 std::int64_t KittiScanTimeline::PublishOffsetUs(int i) const {
   return seq().ScanUtime(i) - base() + seq().options().velodyne.sweep_duration_us;

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "lcmtypes/util/process.h"
 #include "sensor_driver/kitti/kitti_sequence.h"
 #include "tests/support/lcm_log.h"
+#include "tests/support/subprocess.h"
 #include "tests/support/test_env.h"
 
 namespace vtrack {
@@ -30,6 +32,21 @@ std::string Encode(const T& m) {
   std::string b(m.getEncodedSize(), '\0');
   m.encode(b.data(), 0, static_cast<int>(b.size()));
   return b;
+}
+
+// A folder of the boxes layout has no point clouds: the driver refuses it before its first lap
+// (a file:// URL: nothing goes on a bus).
+TEST(KittiReplayTest, DriverRefusesASequenceWithoutPointClouds) {
+  const std::string boxes = testing::DataDir() + "/kitti_tracking_boxes";
+  if (!std::filesystem::is_directory(boxes)) GTEST_SKIP() << boxes << " not found: skipped";
+  const std::string dir = ScratchDir("kitti_driver_boxes");
+  const int rc = testing::RunCommand(
+      {BinDir() + "/vtrack-ladar-driver", "--lcm-url", "file://" + dir + "/l.lcm?mode=w", "--kitti",
+       boxes, "--sequence", "0017", "--stop-after", "2"},
+      dir + "/driver.txt", std::chrono::seconds(60));
+  const std::string out = testing::ReadFile(dir + "/driver.txt");
+  EXPECT_EQ(rc, 1) << out;
+  EXPECT_NE(out.find("has no Velodyne point clouds"), std::string::npos) << out;
 }
 
 TEST(KittiReplayTest, DriverAndEgoPosePublishTheSequenceOnTheRunClock) {

@@ -187,9 +187,12 @@ int RunOffline(const TrackerParams& params, const NodeOptions& options, const st
     }
     const std::string wanted = boxes ? options.detections_channel
                                      : options.scan_channel + " or " + options.slice_channel;
-    std::fprintf(stderr, "vtrack-tracker: warning: nothing to track: no %s message in %s (%s)\n",
+    const std::string undecodable =
+        s.decode_errors > 0 ? "; " + std::to_string(s.decode_errors) + " messages could not be decoded" : "";
+    std::fprintf(stderr, "vtrack-tracker: warning: nothing to track: no %s message in %s (%s%s)\n",
                  wanted.c_str(), input.c_str(),
-                 seen.empty() ? "the log holds no message" : ("channels: " + seen).c_str());
+                 seen.empty() ? "the log holds no message" : ("channels: " + seen).c_str(),
+                 undecodable.c_str());
   }
   if (reader.damaged()) {
     std::fprintf(stderr, "vtrack-tracker: %s\n", reader.DamageSummary().c_str());

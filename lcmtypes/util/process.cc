@@ -30,8 +30,15 @@ void RequestStop() { g_stop.store(true); }
 std::unique_ptr<lcm::LCM> OpenLcm(const std::string& url) {
   auto lcm = std::make_unique<lcm::LCM>(url);
   if (!lcm->good()) {
-    throw std::runtime_error("cannot open LCM at '" + (url.empty() ? "<default>" : url) +
-                             "' (no multicast route? see README: private network namespace)");
+    // The likely cause by provider: a udpm:// bus needs a multicast route; other providers,
+    // a URL LCM can open (memq://, file://PATH?mode=r|w with a readable or writable PATH).
+    const bool udpm = url.empty() || url.rfind("udpm://", 0) == 0;
+    throw std::runtime_error(
+        "cannot open LCM at '" + (url.empty() ? "<default>" : url) + "' (" +
+        (udpm ? "no multicast route? see README: private network namespace"
+              : "LCM's providers are udpm://, memq:// and file://PATH?mode=r|w; for file://, the "
+                "file must be readable (mode=r) or its folder writable (mode=w)") +
+        ")");
   }
   return lcm;
 }

@@ -7,6 +7,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -164,6 +165,10 @@ void CheckDimensions(double height, double width, double length, const std::stri
 }  // namespace
 
 VelodyneFrame ReadVelodyneBin(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw KittiError("Velodyne file " + path + " is a directory, not a frame's returns");
+  }
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw KittiError("cannot open Velodyne file " + path + ": " + std::strerror(errno));
   const std::streamoff bytes = in.tellg();
@@ -204,6 +209,10 @@ Eigen::Affine3d Calibration::RectFromVelo() const {
 Eigen::Affine3d Calibration::VeloFromRect() const { return RectFromVelo().inverse(Eigen::Affine); }
 
 Calibration ReadCalibration(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw KittiError("calibration file " + path + " is a directory (calib/NNNN.txt is the file)");
+  }
   // Canonical key -> (number of values, line found, values).
   struct Entry {
     int line = 0;

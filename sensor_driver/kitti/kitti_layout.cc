@@ -24,6 +24,18 @@ namespace vtrack::kitti {
 namespace fs = std::filesystem;
 namespace {
 
+// "does not exist", or what is there instead: for the error of a path that must be a folder or a
+// regular file.
+std::string NotThere(const fs::path& p) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(p, ec);
+  if (!fs::exists(st)) return "does not exist";
+  if (fs::is_directory(st)) return "is a directory, not a file";
+  if (fs::is_regular_file(st)) return "is a file, not a directory";
+  return "is not a regular file";
+}
+
+
 void Say(const MessageSink& sink, const std::string& msg) {
   if (sink) {
     sink(msg);
@@ -178,7 +190,7 @@ std::vector<std::string> PointCloudSequences(const std::string& dir) {
 std::string ResolveSequence(const std::string& dir, const std::string& requested) {
   if (!requested.empty()) return NormaliseSequence(requested);
   if (dir.empty()) throw KittiError("no KITTI directory given");
-  if (!fs::is_directory(dir)) throw KittiError("KITTI directory " + dir + " does not exist");
+  if (!fs::is_directory(dir)) throw KittiError("KITTI directory " + dir + " " + NotThere(dir));
   std::vector<std::string> seqs = PointCloudSequences(dir);
   if (seqs.empty()) {
     // No point clouds (the boxes layout): the sequences with a calibration file.
@@ -289,7 +301,7 @@ SequencePaths LocateSequence(const std::string& dir, const std::string& sequence
                              const std::string& cache_dir, const MessageSink& sink) {
   const std::string seq = NormaliseSequence(sequence);
   if (dir.empty()) throw KittiError("no KITTI directory given");
-  if (!fs::is_directory(dir)) throw KittiError("KITTI directory " + dir + " does not exist");
+  if (!fs::is_directory(dir)) throw KittiError("KITTI directory " + dir + " " + NotThere(dir));
   if (!poses_file.empty() && !oxts_file.empty()) {
     throw KittiError("give either a poses file or an OXTS file, not both (" + poses_file + ", " +
                      oxts_file + ")");
@@ -317,7 +329,7 @@ SequencePaths LocateSequence(const std::string& dir, const std::string& sequence
   }
   p.calib_file = (root / "calib" / (seq + ".txt")).string();
   if (!fs::is_regular_file(p.calib_file)) {
-    throw KittiError("calibration file " + p.calib_file + " does not exist");
+    throw KittiError("calibration file " + p.calib_file + " " + NotThere(p.calib_file));
   }
   const fs::path labels = root / "label_02" / (seq + ".txt");
   if (fs::is_regular_file(labels)) p.label_file = labels.string();
@@ -325,10 +337,10 @@ SequencePaths LocateSequence(const std::string& dir, const std::string& sequence
   if (fs::is_regular_file(detections)) p.detections_file = detections.string();
 
   if (!poses_file.empty()) {
-    if (!fs::is_regular_file(poses_file)) throw KittiError("poses file " + poses_file + " does not exist");
+    if (!fs::is_regular_file(poses_file)) throw KittiError("poses file " + poses_file + " " + NotThere(poses_file));
     p.poses_file = poses_file;
   } else if (!oxts_file.empty()) {
-    if (!fs::is_regular_file(oxts_file)) throw KittiError("OXTS file " + oxts_file + " does not exist");
+    if (!fs::is_regular_file(oxts_file)) throw KittiError("OXTS file " + oxts_file + " " + NotThere(oxts_file));
     p.oxts_file = oxts_file;
   } else {
     const fs::path oxts = root / "oxts" / (seq + ".txt");

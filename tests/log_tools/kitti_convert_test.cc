@@ -272,6 +272,13 @@ TEST(KittiConvertToolTest, ClearErrorsForMissingAndBadData) {
   auto [rc, out] = RunTool({"--kitti", dir + "/absent", "--out", out_file}, dir);
   EXPECT_EQ(rc, 1);
   EXPECT_NE(out.find(dir + "/absent does not exist"), std::string::npos) << out;
+  // A file where the folder should be, and a folder where the poses file should be: said.
+  std::tie(rc, out) = RunTool({"--kitti", dir + "/poses.txt", "--out", out_file}, dir);
+  EXPECT_EQ(rc, 1);
+  EXPECT_NE(out.find(dir + "/poses.txt is a file, not a directory"), std::string::npos) << out;
+  std::tie(rc, out) = RunTool({"--kitti", dir, "--out", out_file, "--poses", dir + "/calib"}, dir);
+  EXPECT_EQ(rc, 1);
+  EXPECT_NE(out.find(dir + "/calib is a directory, not a file"), std::string::npos) << out;
   std::tie(rc, out) = RunTool({"--kitti", dir, "--sequence", "7", "--out", out_file, "--poses", dir + "/poses.txt"}, dir);
   EXPECT_EQ(rc, 1);
   EXPECT_NE(out.find("sequence 0007 not found"), std::string::npos) << out;

@@ -10,10 +10,11 @@
 
 namespace vtrack {
 
-// [us since the Unix epoch] The latest start time a log or a live run may be given (2^53 us,
-// the year 2255): every later utime of a run stays exactly representable in a double, as the
-// tracker's and the scorers' times in seconds are, and far from int64's overflow.
-inline constexpr std::int64_t kMaxStartUtime = std::int64_t{1} << 53;
+// [us since the Unix epoch] The latest start time a log or a live run may be given (2^52 us, in
+// the year 2112): a run shorter than a century then keeps every utime below 2^53, exact in a
+// double as the tracker's and the scorers' times in seconds take it, and far from int64's
+// overflow.
+inline constexpr std::int64_t kMaxStartUtime = std::int64_t{1} << 52;
 
 // Pose at s in [0, 1] between a (s = 0) and b (s = 1): linear in translation, slerp in rotation.
 // s outside [0, 1] extrapolates at constant linear and angular velocity.

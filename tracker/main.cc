@@ -129,7 +129,11 @@ int RunLive(const TrackerParams& params, NodeOptions options, const std::string&
 int RunOffline(const TrackerParams& params, const NodeOptions& options, const std::string& input,
                const std::string& output, double status_period_s, bool quiet) {
   lcm_util::LogReader reader(input);
-  // The node first: its evidence CSV refused leaves an existing output log as it was.
+  // Neither output is truncated before both can be written: the log's place checked, then the
+  // node (which creates the evidence CSV), then the log.
+  if (const std::string why = lcm_util::WhyNotWritable(output); !why.empty()) {
+    throw std::runtime_error("cannot create LCM log '" + output + "': " + why);
+  }
   std::unique_ptr<lcm_util::LogWriter> writer;
   TrackerNode node(params, options,
                    [&](std::int64_t t, const std::string& ch, const void* data, std::size_t size) {

@@ -312,13 +312,17 @@ int main(int argc, char** argv) {
                    output.png_dir.c_str());
     }
     if (sink.video_frames() == 0 && sink.png_paths().empty()) {
-      // Not a success: the user asked for images and has none (a window of time past the logs'
-      // end, logs without the trigger channel, a bus on which nothing came).
-      std::fprintf(stderr,
-                   "vtrack-render: nothing written%s: no frame within --start/--end%s\n",
-                   output.video_path.empty() ? "" : (" (no video " + output.video_path + ")").c_str(),
-                   output.png_at_s.empty() ? "" : ", or none at a --png-at time");
-      return 1;
+      // From logs, not a success: the user asked for images of them and has none (a window of
+      // time past their end, none at a --png-at time). Live, a display stopped before anything
+      // came on the bus has drawn nothing either, which is said but is no failure.
+      const std::string what =
+          output.video_path.empty() ? "" : " (no video " + output.video_path + ")";
+      if (!inputs.empty()) {
+        std::fprintf(stderr, "vtrack-render: nothing written%s: no frame within --start/--end%s\n",
+                     what.c_str(), output.png_at_s.empty() ? "" : ", or none at a --png-at time");
+        return 1;
+      }
+      std::fprintf(stderr, "vtrack-render: nothing written%s: no frame came on the bus\n", what.c_str());
     }
   } catch (const std::exception& e) {
     std::cerr << "vtrack-render: error: " << e.what() << "\n";

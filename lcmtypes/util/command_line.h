@@ -3,6 +3,7 @@
 #pragma once
 
 #include <boost/program_options.hpp>
+#include <unistd.h>
 
 #include <filesystem>
 #include <iostream>
@@ -53,9 +54,27 @@ inline bool SameFile(const std::string& a, const std::string& b) {
   if (std::filesystem::equivalent(a, b, ec) && !ec) return true;
   const auto normal = [](const std::string& p) {
     std::error_code e;
-    return std::filesystem::weakly_canonical(std::filesystem::absolute(p, e), e).lexically_normal();
+    const std::filesystem::path abs = std::filesystem::absolute(p, e);
+    const std::filesystem::path canonical = std::filesystem::weakly_canonical(abs, e);
+    // A look-up refused (a folder without search permission): the path as written, normalised.
+    return (e || canonical.empty() ? abs : canonical).lexically_normal();
   };
   return normal(a) == normal(b);
+}
+
+// "" if path can be written: an existing file that is writable, or a new one in a writable
+// folder (through a symbolic link, the file it names); else why not. Nothing is created.
+inline std::string WhyNotWritable(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path target = fs::weakly_canonical(fs::absolute(path, ec), ec);
+  const fs::path p = ec || target.empty() ? fs::path(path) : target;
+  const fs::file_status st = fs::status(p, ec);
+  if (fs::is_directory(st)) return "is a directory";
+  if (fs::exists(st)) return ::access(p.c_str(), W_OK) == 0 ? "" : "is not writable";
+  const fs::path folder = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  if (!fs::is_directory(folder, ec)) return "its folder " + folder.string() + " does not exist";
+  return ::access(folder.c_str(), W_OK) == 0 ? "" : "its folder " + folder.string() + " is not writable";
 }
 
 // Throws boost::program_options::error if an output would overwrite an input or another output

@@ -20,6 +20,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "lcmtypes/util/command_line.h"
 #include "lcmtypes/util/process.h"
 #include "log_tools/eval/json_writer.h"
 #include "log_tools/eval/progress.h"
@@ -317,20 +318,17 @@ int RunCompare(const CompareOptions& o) {
   // Work directory.
   // The outputs first: a --json or --plots that cannot be written is said before any run, not
   // after all of them.
+  if (!o.json_path.empty()) {
+    if (const std::string why = lcm_util::WhyNotWritable(o.json_path); !why.empty()) {
+      throw std::runtime_error("cannot write --json '" + o.json_path + "': " + why);
+    }
+  }
   if (!o.plots_dir.empty()) {
     std::error_code ec;
     fs::create_directories(o.plots_dir, ec);
     if (!fs::is_directory(o.plots_dir)) {
       throw std::runtime_error("cannot create --plots directory '" + o.plots_dir + "'");
     }
-  }
-  if (!o.json_path.empty()) {
-    const bool existed = fs::exists(o.json_path);
-    if (!std::ofstream(o.json_path, std::ios::app)) {
-      throw std::runtime_error("cannot write --json '" + o.json_path + "'");
-    }
-    std::error_code ec;
-    if (!existed) fs::remove(o.json_path, ec);
   }
   std::string work = o.work_dir;
   bool temporary = false;

@@ -103,6 +103,15 @@ int main(int argc, char** argv) {
   try {
     const auto start = std::chrono::steady_clock::now();
     const vtrack::kitti::Sequence seq(seq_opt);
+    {
+      // The sequence's own files, once found, are inputs too.
+      const vtrack::kitti::SequencePaths& p = seq.paths();
+      vtrack::lcm_util::RefuseOverwritingInputs(
+          {{"the calibration", p.calib_file}, {"the labels", p.label_file}, {"the poses", p.poses_file},
+           {"the OXTS file", p.oxts_file}, {"the camera poses", p.camera_poses_file},
+           {"the detections", p.detections_file}},
+          {{"--out", conv.out}});
+    }
     if (!quiet) {
       std::cerr << "vtrack-kitti2lcm: sequence " << seq.sequence() << ": " << seq.num_frames()
                 << " frames from "

@@ -92,7 +92,7 @@ SimCli ReadSimCli(const po::variables_map& vm) {
   get("start-utime", &c.start_utime);
   if (c.start_utime && (*c.start_utime < 0 || *c.start_utime > vtrack::kMaxStartUtime)) {
     throw po::error("--start-utime = " + std::to_string(*c.start_utime) + ": must be in [0, " +
-                    std::to_string(vtrack::kMaxStartUtime) + "] us (2^53: the year 2255)");
+                    std::to_string(vtrack::kMaxStartUtime) + "] us (2^52: the year 2112)");
   }
   get("seed", &c.run.seed);
   if (vm.count("sensor")) c.run.sensor = vm["sensor"].as<std::string>();

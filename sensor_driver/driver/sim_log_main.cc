@@ -8,10 +8,11 @@
 #include <filesystem>
 #include <iostream>
 
-#include "lcmtypes/util/log_reader.h"
 #include "lcmtypes/util/command_line.h"
+#include "lcmtypes/util/log_reader.h"
 #include "sensor_driver/driver/sim_cli.h"
 #include "sensor_driver/sim/describe.h"
+#include "sensor_driver/sim/scenario.h"
 #include "sensor_driver/sim/sim_log.h"
 
 namespace po = boost::program_options;
@@ -39,7 +40,14 @@ int main(int argc, char** argv) {
     if (!vm.count("scenario")) throw po::error("--scenario is required");
     if (!vm.count("out") && !vm.count("describe")) throw po::error("--out is required");
     if (vm.count("out")) {
-      vtrack::lcm_util::RefuseOverwritingInputs({{"--scenario", vm["scenario"].as<std::string>()}},
+      // The file the scenario's name resolves to (config/scenarios/NAME.yaml, ...), if any.
+      std::string scenario = vm["scenario"].as<std::string>();
+      try {
+        scenario = vtrack::sim::ResolveScenarioPath(scenario);
+      } catch (const std::exception&) {
+        // no such scenario: said when it is loaded
+      }
+      vtrack::lcm_util::RefuseOverwritingInputs({{"--scenario", scenario}},
                                                 {{"--out", vm["out"].as<std::string>()}});
     }
     vtrack::sim::ReadSweepOutputOptions(vm);

@@ -104,7 +104,7 @@ std::string SequenceOptions::Validate() const {
   else if (start_utime <= velodyne.sweep_duration_us / 2)
     os << "start_utime must be > half a sweep (" << velodyne.sweep_duration_us / 2 << " us), got " << start_utime;
   else if (start_utime > kMaxStartUtime)
-    os << "start_utime must be <= " << kMaxStartUtime << " us (2^53: the year 2255), got " << start_utime;
+    os << "start_utime must be <= " << kMaxStartUtime << " us (2^52: the year 2112), got " << start_utime;
   else if (image_width <= 0) os << "image_width must be > 0 px, got " << image_width;
   else if (image_height <= 0) os << "image_height must be > 0 px, got " << image_height;
   else if (!(moving_threshold_m > 0.0) || !std::isfinite(moving_threshold_m))

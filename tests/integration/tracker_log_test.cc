@@ -594,6 +594,12 @@ TEST(TrackerCliTest, OutputsThatWouldDestroyAnInputAreRefused) {
                         dir + "/no/such/dir/e.csv"}, out, std::chrono::seconds(30)), 1);
   EXPECT_NE(ReadFile(out).find("cannot write the evidence CSV"), std::string::npos) << ReadFile(out);
   EXPECT_EQ(ReadFile(keep), "an earlier run's log");
+  // The other way round: an --output that cannot be created leaves an existing CSV as it was.
+  std::ofstream(dir + "/e.csv") << "an earlier run's rows";
+  EXPECT_EQ(RunCommand({Bin("vtrack-tracker"), "--input", in, "--output", dir + "/no/such/dir/o.lcm",
+                        "--evidence-csv", dir + "/e.csv"}, out, std::chrono::seconds(30)), 1);
+  EXPECT_NE(ReadFile(out).find("o.lcm': its folder"), std::string::npos) << ReadFile(out);
+  EXPECT_EQ(ReadFile(dir + "/e.csv"), "an earlier run's rows");
 }
 
 // A run that finds nothing to track (a wrong channel name, boxes asked of a log without any) says

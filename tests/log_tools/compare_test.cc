@@ -76,6 +76,13 @@ TEST_F(CompareTest, HelpAndBadOptions) {
   EXPECT_NE(out.find("cannot create --plots directory"), std::string::npos) << out;
   EXPECT_TRUE(fs::is_empty(tmp)) << "a temporary work directory was left in " << tmp;
   EXPECT_FALSE(fs::exists(dir_ + "/no"));
+  // The check creates nothing: a --json through a link not yet pointing at a file stays a link.
+  fs::remove(dir_ + "/link.json");
+  fs::create_symlink("target.json", dir_ + "/link.json");
+  EXPECT_EQ(RunTool({"--scenarios", "a", "--bin-dir", fake_bin_, "--json", dir_ + "/link.json",
+                     "--plots", dir_ + "/a_file/plots"}, &out, {"TMPDIR=" + tmp}), 1);
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir_ + "/link.json")));
+  EXPECT_FALSE(fs::exists(dir_ + "/target.json"));
 }
 
 TEST_F(CompareTest, ThreeModesOnTwoScenariosAndKitti) {

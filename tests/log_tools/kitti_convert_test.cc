@@ -143,9 +143,6 @@ TEST(KittiConvertTest, SyntheticLogHasEveryChannelInTimeOrder) {
   EXPECT_EQ(last_pose, seq.LastPoseUtime());
 }
 
-// Without scans (--no-scans) a raw sequence is written as the boxes layout is: no LADAR_SCAN,
-// the ground truth stamped with each frame's time (half a sweep after the scan's start).
-
 // --out through a symbolic link writes the file the link names (the link stays); a special file
 // such as /dev/null is written directly, not replaced by a moved file; a directory is refused
 // before anything is converted.
@@ -183,6 +180,8 @@ TEST(KittiConvertTest, OutputThroughLinksAndSpecialFilesIsWrittenNotReplaced) {
   EXPECT_TRUE(fs::is_directory(so.dir + "/logs"));
   EXPECT_FALSE(fs::exists(so.dir + "/logs.partial"));
 }
+// Without scans (--no-scans) a raw sequence is written as the boxes layout is: no LADAR_SCAN,
+// the ground truth stamped with each frame's time (half a sweep after the scan's start).
 TEST(KittiConvertTest, NoScansStampsTheTruthWithTheFrameTime) {
   SequenceOptions so = WriteSyntheticOptions("kitti_convert_no_scans");
   so.no_scans = true;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <string>
@@ -261,6 +262,16 @@ TEST(SimLogTest, CommandLineErrorsAreClear) {
   EXPECT_EQ(SimLog({"--scenario", dir + "/bad.yaml", "--out", dir + "/bad.yaml"}, dir + "/self.txt"), 2);
   EXPECT_NE(ReadFile(dir + "/self.txt").find("is also the input --scenario"), std::string::npos)
       << ReadFile(dir + "/self.txt");
+  // ... nor the file a scenario's name resolves to.
+  std::filesystem::create_directories(dir + "/scenarios");
+  std::ofstream(dir + "/scenarios/mine.yaml") << "extends: paper_fig4_turn\n";
+  const std::string yaml = ReadFile(dir + "/scenarios/mine.yaml");
+  EXPECT_EQ(RunCommand({"env", "VTRACK_SCENARIO_DIR=" + dir + "/scenarios", BinDir() + "/vtrack-sim-log",
+                        "--scenario", "mine", "--out", dir + "/scenarios/mine.yaml"},
+                       dir + "/named.txt"), 2) << ReadFile(dir + "/named.txt");
+  EXPECT_NE(ReadFile(dir + "/named.txt").find("is also the input --scenario"), std::string::npos)
+      << ReadFile(dir + "/named.txt");
+  EXPECT_EQ(ReadFile(dir + "/scenarios/mine.yaml"), yaml);
   EXPECT_EQ(SimLog({"--scenario", "urban_intersection", "--describe"}, dir + "/describe.txt"), 0);
   EXPECT_NE(ReadFile(dir + "/describe.txt").find("no overlapping footprints"), std::string::npos);
 }

@@ -238,6 +238,11 @@ TEST(RenderLogTest, StartEndAndMaxFrames) {
   r = Render(dir, Cat(Inputs(logs), {"--png-dir", dir + "/png", "--png-at", "1000"}));
   EXPECT_EQ(r.status, 1) << r.output;
   EXPECT_NE(r.output.find("or none at a --png-at time"), std::string::npos) << r.output;
+  // Live, a display stopped before anything came says so, and that is no failure.
+  r = Render(dir, {"--lcm-url", "memq://", "--duration", "0.3", "--video", dir + "/live.mp4"});
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("nothing written (no video " + dir + "/live.mp4): no frame came on the bus"),
+            std::string::npos) << r.output;
 }
 
 TEST(RenderMainTest, HelpAndBadOptions) {

@@ -54,6 +54,7 @@ TEST(KittiVelodyneTest, RefusesTruncatedAndMissingFiles) {
   std::ofstream(path, std::ios::binary) << std::string(17, '\0');
   ExpectErrorMentions([&] { ReadVelodyneBin(path); }, {path, "17 bytes", "multiple of 16"});
   ExpectErrorMentions([&] { ReadVelodyneBin(dir + "/nope.bin"); }, {dir + "/nope.bin"});
+  ExpectErrorMentions([&] { ReadVelodyneBin(dir); }, {dir, "is a directory"});
 }
 
 // The tracking benchmark's spelling of the keys, with a tilted (not axis-aligned) calibration.
@@ -142,6 +143,7 @@ TEST(KittiCalibrationTest, ErrorsNameFileLineAndValue) {
   ExpectErrorMentions([&] { ReadCalibration(p1); }, {p1 + ":2", "R0_rect"});
   const std::string p2 = WriteText(dir, "no_p2.txt", text.substr(text.find('\n') + 1));
   ExpectErrorMentions([&] { ReadCalibration(p2); }, {p2, "missing calibration entry P2"});
+  ExpectErrorMentions([&] { ReadCalibration(dir); }, {dir, "is a directory"});
   const std::string p3 = WriteText(dir, "short.txt", "P2: 1 0 0 0 0 1 0 0 0 0 1\nR0_rect: 1 0 0 0 1 0 0 0 1\n");
   ExpectErrorMentions([&] { ReadCalibration(p3); }, {p3 + ":1", "P2 has 11 values, expected 12"});
   const std::string p4 = WriteText(dir, "scaled.txt",

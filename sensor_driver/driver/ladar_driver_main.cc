@@ -70,6 +70,9 @@ int main(int argc, char** argv) {
                  sim->scenario().name.c_str(), sim->sensor().name.c_str(),
                  sim->sensor().NumLayers(), sim->sensor().rate_hz, sim->sensor().NumColumns(),
                  static_cast<unsigned long long>(sim->seed()), sim->NumScans());
+    if (const std::string w = vtrack::sim::SweepsLeftOutWarning(*sim); !w.empty()) {
+      std::fprintf(stderr, "vtrack-ladar-driver: %s\n", w.c_str());
+    }
     return std::make_unique<vtrack::sim::SimScanTimeline>(sim, lcm, output, truth_channel);
   };
   return vtrack::sim::RunLive(vm, cli, name, "scans", source);

@@ -110,6 +110,19 @@ std::unique_ptr<Simulator> MakeSimulator(const SimCli& cli) {
   return std::make_unique<Simulator>(LoadScenario(path, cli.duration), cli.run);
 }
 
+std::string SweepsLeftOutWarning(const Simulator& sim) {
+  const int lost = sim.NumSweepsInRun() - sim.NumScans();
+  if (lost <= 0) return "";
+  char buf[400];
+  std::snprintf(buf, sizeof buf,
+                "warning: %d of the scenario's %d sweeps are left out: they end after its last "
+                "pose (%.3f s into the run at %g Hz), and the tracker needs a pose after a sweep "
+                "to place its returns; a higher --pose-rate (at most 1000 Hz) keeps them",
+                lost, sim.NumSweepsInRun(), sim.PoseOffsetUs(sim.NumPoses() - 1) * 1e-6,
+                sim.pose_rate_hz());
+  return buf;
+}
+
 bool ParseCommandLine(int argc, char** argv, const po::options_description& desc,
                       const std::string& usage, po::variables_map* vm) {
   return lcm_util::StoreCommandLine(po::command_line_parser(argc, argv).options(desc).run(), desc,

@@ -45,6 +45,10 @@ SimCli ReadSimCli(const boost::program_options::variables_map& vm);
 // std::invalid_argument) with a message fit for the user.
 std::unique_ptr<Simulator> MakeSimulator(const SimCli& cli);
 
+// Empty, or a warning that the pose rate leaves the last sweeps of the run out (no pose follows
+// them), with how many and what rate would keep them.
+std::string SweepsLeftOutWarning(const Simulator& sim);
+
 // Parses argv against desc; prints help (with usage) and returns false if --help was given.
 // Throws boost::program_options::error on bad options.
 bool ParseCommandLine(int argc, char** argv, const boost::program_options::options_description& desc,

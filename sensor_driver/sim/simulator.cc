@@ -78,6 +78,11 @@ Simulator::Simulator(Scenario scenario, const RunOptions& options)
   while (PoseOffsetUs(num_poses_) < run_us_) ++num_poses_;
   const std::int64_t last_pose = PoseOffsetUs(num_poses_ - 1);
   while (ScanPublishOffsetUs(num_scans_) <= last_pose) ++num_scans_;
+  // The sweeps a pose at the highest rate allowed (1 kHz, its last pose the last whole
+  // millisecond before the run's end) would keep.
+  const std::int64_t last_pose_at_1khz = (run_us_ - 1) / 1000 * 1000;
+  num_sweeps_in_run_ = num_scans_;
+  while (ScanPublishOffsetUs(num_sweeps_in_run_) <= last_pose_at_1khz) ++num_sweeps_in_run_;
   if (num_scans_ == 0) {
     throw std::invalid_argument("scenario '" + scenario_.name + "' lasts " +
                                 Str(scenario_.duration) + " s: too short for one sweep of '" +

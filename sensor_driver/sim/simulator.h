@@ -67,7 +67,12 @@ class Simulator {
   const PoseNoiseParams& pose_noise() const { return pose_noise_; }
 
   std::int64_t RunDurationUs() const { return run_us_; }
+  // Scans of the run: those that end before its last pose (the tracker places a sweep's returns
+  // between the poses around them, so a sweep after the last pose could not be used).
   int NumScans() const { return num_scans_; }
+  // Scans of the run at the highest pose rate (1 kHz): NumScans() when poses come often enough,
+  // more when the pose rate leaves the last of them without a pose after their end.
+  int NumSweepsInRun() const { return num_sweeps_in_run_; }
   std::int64_t ScanOffsetUs(int i) const;          // scan utime - run start
   std::int64_t ScanPublishOffsetUs(int i) const;   // + sweep_duration_us
   int NumPoses() const { return num_poses_; }
@@ -89,6 +94,7 @@ class Simulator {
   PoseNoiseParams pose_noise_;
   std::int64_t run_us_ = 0;
   int num_scans_ = 0;
+  int num_sweeps_in_run_ = 0;
   int num_poses_ = 0;
   std::vector<int> hits_;
   // Gauss-Markov pose noise, advanced sequentially: state at pose noise_k_.

@@ -119,6 +119,49 @@ TEST(SimLogTest, EveryChannelAtItsRateWithoutGaps) {
   }
 }
 
+// A pose rate too low for the last sweeps (6 s at 25 Hz, poses at 2 Hz: the last pose at 5.5 s)
+// leaves them out, as the tracker could not place their returns, and says how many; the default
+// rate leaves none out and says nothing.
+TEST(SimLogTest, SweepsLeftOutByALowPoseRateAreCountedInAWarning) {
+  const std::string dir = ScratchDir("sim_log_low_pose_rate");
+  const std::string log = dir + "/run.lcm";
+  const std::int64_t start = 1600000000000000;
+  ASSERT_EQ(SimLog({"--scenario", "paper_fig5_follow_clutter", "--duration", "6", "--pose-rate",
+                    "2", "--start-utime", std::to_string(start), "--out", log, "-q"},
+                   dir + "/out.txt"),
+            0)
+      << ReadFile(dir + "/out.txt");
+  int scans = 0;
+  std::int64_t last_pose = 0, last_sweep_end = 0, sweep_us = 0;
+  for (const LoggedEvent& e : ReadLogEvents(log)) {
+    if (e.channel == "LADAR_SCAN") {
+      const auto scan = DecodeOrDie<ladar_scan_t>(e);
+      last_sweep_end = scan.utime + scan.sweep_duration_us;
+      sweep_us = scan.sweep_duration_us;
+      ++scans;
+    } else if (e.channel == "EGO_POSE") {
+      last_pose = DecodeOrDie<pose_t>(e).utime;
+    }
+  }
+  ASSERT_GT(scans, 0);
+  EXPECT_EQ(last_pose, start + 5500000);
+  // Every sweep that ends by the last pose is logged, and no other.
+  EXPECT_LE(last_sweep_end, last_pose);
+  EXPECT_GT(start + scans * 40000 + sweep_us, last_pose);
+  // The sweeps of 6 s at 25 Hz that end by the last whole millisecond (150), less those logged.
+  const std::string said = ReadFile(dir + "/out.txt");
+  EXPECT_NE(said.find("warning: " + std::to_string(150 - scans) + " of the scenario's 150 sweeps "
+                      "are left out"),
+            std::string::npos)
+      << said;
+
+  ASSERT_EQ(SimLog({"--scenario", "paper_fig5_follow_clutter", "--duration", "6", "--out", log,
+                    "-q"},
+                   dir + "/out.txt"),
+            0);
+  EXPECT_EQ(ReadFile(dir + "/out.txt"), "");
+}
+
 Eigen::Isometry3d PoseOf(const pose_t& p) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = Eigen::Quaterniond(p.orientation[0], p.orientation[1], p.orientation[2],

@@ -169,7 +169,9 @@ double Iou3d(const Box3d& a, const Box3d& b) {
   return uni > 0.0 ? std::min(1.0, inter / uni) : 0.0;
 }
 
-std::vector<KittiObject> ReadTrackingFile(const std::string& path, bool is_result) {
+std::vector<KittiObject> ReadTrackingFile(const std::string& path, bool is_result,
+                                          std::int64_t* last_frame) {
+  if (last_frame != nullptr) *last_frame = -1;
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open");
   std::vector<KittiObject> out;
@@ -212,6 +214,7 @@ std::vector<KittiObject> ReadTrackingFile(const std::string& path, bool is_resul
     o.box.ry = ParseNumber(f[16], where, "rotation_y");
     o.score = f.size() == 18 ? ParseNumber(f[17], where, "score") : -1.0;
     if (o.frame < 0) throw std::runtime_error(where + ": negative frame " + f[0]);
+    if (last_frame != nullptr) *last_frame = std::max(*last_frame, o.frame);
 
     if (type == "car") {
       o.type = ObjectType::kCar;
@@ -372,6 +375,11 @@ std::vector<int> MatchMostPairsMinCost(const std::vector<double>& cost,
     if (allowed[static_cast<std::size_t>(row) * cols + col]) result[row] = col;
   }
   return result;
+}
+
+std::int64_t RowsAfterFrame(const std::vector<KittiObject>& result, std::int64_t last_label_frame) {
+  return std::count_if(result.begin(), result.end(),
+                       [&](const KittiObject& o) { return o.frame > last_label_frame; });
 }
 
 PreparedSequence::PreparedSequence(std::string name, const std::vector<KittiObject>& gt,

@@ -111,8 +111,15 @@ struct KittiObject {
 // Reads one label or result file, keeping the rows that rule 1 keeps. Throws
 // std::runtime_error "path:line: reason" for a malformed line (field count, a field that is
 // not a number, a frame or id that is not an integer, a negative frame, a duplicate id in a
-// frame of a result), or "path: reason" if it cannot be opened.
-std::vector<KittiObject> ReadTrackingFile(const std::string& path, bool is_result);
+// frame of a result), or "path: reason" if it cannot be opened. If last_frame is given, it is
+// set to the largest frame of any well-formed row, of any type (-1 for a file without rows).
+std::vector<KittiObject> ReadTrackingFile(const std::string& path, bool is_result,
+                                          std::int64_t* last_frame = nullptr);
+
+// The number of rows of `result` in frames after last_label_frame: the labels say nothing of
+// those frames, so each such row is a false positive, and many of them usually mean that the
+// results are of another sequence or counted from another first frame.
+std::int64_t RowsAfterFrame(const std::vector<KittiObject>& result, std::int64_t last_label_frame);
 
 struct Params {
   double min_iou = 0.25;         // rule 4: a match needs IoU >= this; (0, 1]

@@ -255,8 +255,24 @@ int main(int argc, char** argv) {
     all.name = "all";
     for (std::size_t k = 0; k < o.sequences.size(); ++k) {
       const std::string& name = o.sequences[k];
-      const auto gt = ReadTrackingFile((fs::path(o.labels_dir) / (name + ".txt")).string(), false);
-      const auto res = ReadTrackingFile((fs::path(o.results_dir) / (name + ".txt")).string(), true);
+      const std::string labels_path = (fs::path(o.labels_dir) / (name + ".txt")).string();
+      const std::string results_path = (fs::path(o.results_dir) / (name + ".txt")).string();
+      std::int64_t last_label_frame = -1;
+      const auto gt = ReadTrackingFile(labels_path, false, &last_label_frame);
+      const auto res = ReadTrackingFile(results_path, true);
+      if (const std::int64_t after = RowsAfterFrame(res, last_label_frame); after > 0) {
+        std::int64_t last_result_frame = -1;
+        for (const auto& r : res) last_result_frame = std::max(last_result_frame, r.frame);
+        // Printed with -q too: the score counts these rows, and the cause is usually a mix-up.
+        std::fprintf(stderr,
+                     "vtrack-eval-kitti: warning: %s: %lld car/van rows in frames %lld-%lld, after "
+                     "the last labelled frame (%lld) of %s; each is a false positive (results of "
+                     "another sequence, or frames numbered from another start?)\n",
+                     results_path.c_str(), static_cast<long long>(after),
+                     static_cast<long long>(last_label_frame + 1),
+                     static_cast<long long>(last_result_frame),
+                     static_cast<long long>(last_label_frame), labels_path.c_str());
+      }
       prepared.push_back(std::make_unique<PreparedSequence>(name, gt, res, o.params));
       rows.push_back({name, prepared.back()->frames(), prepared.back()->result_boxes(),
                       Score({prepared.back().get()}, o.params)});

@@ -179,6 +179,19 @@ TEST(KittiMotFiles, ReadsClassesAndRejectsMalformedLines) {
   EXPECT_EQ(gt[1].type, ObjectType::kVan);
   EXPECT_EQ(gt[2].type, ObjectType::kDontCare);
   EXPECT_EQ(gt[2].line, 5);
+  // The last frame counts every row, the skipped pedestrian's too.
+  WriteFile(dir + "/ped_last.txt", Line(car, false) + Line({4, 3, "Pedestrian"}, false));
+  std::int64_t last_frame = 0;
+  EXPECT_EQ(ReadTrackingFile(dir + "/ped_last.txt", false, &last_frame).size(), 1u);
+  EXPECT_EQ(last_frame, 4);
+  WriteFile(dir + "/empty.txt", "\n");
+  EXPECT_TRUE(ReadTrackingFile(dir + "/empty.txt", false, &last_frame).empty());
+  EXPECT_EQ(last_frame, -1);
+  std::vector<KittiObject> rows(5);
+  for (int f = 0; f < 5; ++f) rows[static_cast<std::size_t>(f)].frame = f;
+  EXPECT_EQ(RowsAfterFrame(rows, 2), 2);
+  EXPECT_EQ(RowsAfterFrame(rows, 4), 0);
+  EXPECT_EQ(RowsAfterFrame(rows, -1), 5);
 
   // A result without the score column reads as score -1 (AB3DMOT).
   WriteFile(dir + "/res17.txt", Line(car, false));
@@ -490,6 +503,29 @@ TEST_F(KittiMotCliTest, HandCaseThroughTheCommand) {
   EXPECT_EQ(RunTool({"--labels", dir_ + "/labels", "--results", dir_ + "/results"}, &out), 0)
       << out;
   EXPECT_NE(out.find("[1/1] 0000"), std::string::npos) << out;
+  EXPECT_EQ(out.find("warning"), std::string::npos) << out;
+}
+
+TEST_F(KittiMotCliTest, ResultsAfterTheLastLabelledFrameAreFalsePositivesAndWarned) {
+  // The hand case's labels end at frame 2; two more result rows in frames 5 and 7.
+  const HandCase c = MakeHandCase();
+  WriteFile(dir_ + "/late/0000.txt",
+            c.results + Line({5, 90, "Car", -1, -1, 100, 100, 200, 200, Car(0, 10)}, true) +
+                Line({7, 90, "Car", -1, -1, 100, 100, 200, 200, Car(0, 10)}, true));
+  std::string out;
+  ASSERT_EQ(RunTool({"--labels", dir_ + "/labels", "--results", dir_ + "/late", "-q", "--json",
+                     dir_ + "/late.json"},
+                    &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("warning: " + dir_ + "/late/0000.txt: 2 car/van rows in frames 3-7, after "
+                     "the last labelled frame (2)"),
+            std::string::npos)
+      << out;
+  // Counted: the hand case's 2 false positives and these 2; 6 labelled cars, 1 miss, 1 switch.
+  const YAML::Node all = YAML::LoadFile(dir_ + "/late.json")["all"];
+  EXPECT_EQ(all["fp"].as<int>(), 4);
+  EXPECT_NEAR(all["mota"].as<double>(), 1.0 - (1.0 + 4.0 + 1.0) / 6.0, 1e-6);
 }
 
 TEST_F(KittiMotCliTest, HelpAndErrors) {

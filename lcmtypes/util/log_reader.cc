@@ -120,6 +120,11 @@ const lcm::LogEvent* LogReader::Next() {
 
 std::string LogReader::DamageSummary() const {
   if (!damaged()) return "";
+  if (events_read_ == 0 && damage_.first_offset == 0 && damage_.bytes_skipped == file_size_) {
+    // Nothing in it is an event: no log at all, rather than a log cut short.
+    return "log '" + path_ + "' holds no LCM event: none of its " + std::to_string(file_size_) +
+           " bytes starts a whole one (not an LCM log, or one cut short within its first event)";
+  }
   return "log '" + path_ + "' is damaged: " + std::to_string(damage_.bytes_skipped) +
          " bytes in " + std::to_string(damage_.regions) + " place(s) skipped, the first at byte " +
          std::to_string(damage_.first_offset) + (damage_.truncated ? " (cut short at the end)" : "") +

@@ -46,7 +46,8 @@ class LogReader {
   const LogDamage& damage() const { return damage_; }
   bool damaged() const { return damage_.regions > 0; }
   // "log 'P' is damaged: N bytes in R places skipped, the first at byte B (cut short at the
-  // end); E whole events read", or "" if it is not.
+  // end); E whole events read", "log 'P' holds no LCM event: ..." if no byte of it was read
+  // as an event, or "" if it is not damaged.
   std::string DamageSummary() const;
 
  private:

@@ -181,5 +181,31 @@ TEST(LogReaderTest, LoneHeaderWithHugeLengthReadsNothing) {
   EXPECT_EQ(r.damage().bytes_skipped, 138);
 }
 
+TEST(LogReaderTest, RandomBytesAreSaidToHoldNoEvent) {
+  const std::string path = testing::ScratchDir("log_reader") + "/random.bin";
+  std::string b(5000, '\0');
+  std::uint32_t state = 12345;  // a fixed linear congruential sequence: the same bytes each run
+  for (char& c : b) {
+    state = state * 1664525u + 1013904223u;
+    c = static_cast<char>(state >> 24);
+  }
+  Put(path, b);
+  LogReader r(path);
+  EXPECT_EQ(r.Next(), nullptr);
+  EXPECT_EQ(r.damage().bytes_skipped, 5000);
+  EXPECT_EQ(r.DamageSummary(), "log '" + path +
+                                   "' holds no LCM event: none of its 5000 bytes starts a whole "
+                                   "one (not an LCM log, or one cut short within its first event)");
+  // A log whose first event is whole is damaged, not empty, whatever follows.
+  const Written w = WriteLog("one_then_random.lcm", 1);
+  Put(w.path, Bytes(w.path) + b);
+  LogReader one(w.path);
+  EXPECT_NE(one.Next(), nullptr);
+  EXPECT_EQ(one.Next(), nullptr);
+  EXPECT_NE(one.DamageSummary().find("(cut short at the end); 1 whole events read"),
+            std::string::npos)
+      << one.DamageSummary();
+}
+
 }  // namespace
 }  // namespace vtrack::lcm_util

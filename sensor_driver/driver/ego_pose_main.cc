@@ -52,6 +52,10 @@ int main(int argc, char** argv) {
                  "vtrack-ego-pose: scenario '%s', %.0f Hz, noise %.3f m / %.3f deg, seed %llu\n",
                  sim->scenario().name.c_str(), sim->pose_rate_hz(), sim->pose_noise().position,
                  sim->pose_noise().yaw_deg, static_cast<unsigned long long>(sim->seed()));
+    if (const std::string w = vtrack::sim::SweepsLeftOutWarning(*sim, "--pose-rate", false);
+        !w.empty()) {
+      std::fprintf(stderr, "vtrack-ego-pose: %s\n", w.c_str());
+    }
     return std::make_unique<vtrack::sim::SimPoseTimeline>(sim, lcm, channel);
   };
   return vtrack::sim::RunLive(vm, cli, name, "poses", source);

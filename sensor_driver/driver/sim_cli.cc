@@ -110,16 +110,19 @@ std::unique_ptr<Simulator> MakeSimulator(const SimCli& cli) {
   return std::make_unique<Simulator>(LoadScenario(path, cli.duration), cli.run);
 }
 
-std::string SweepsLeftOutWarning(const Simulator& sim) {
+std::string SweepsLeftOutWarning(const Simulator& sim, const std::string& rate_setting,
+                                 bool left_out_here) {
   const int lost = sim.NumSweepsInRun() - sim.NumScans();
   if (lost <= 0) return "";
-  char buf[400];
+  char buf[512];
   std::snprintf(buf, sizeof buf,
-                "warning: %d of the scenario's %d sweeps are left out: they end after its last "
-                "pose (%.3f s into the run at %g Hz), and the tracker needs a pose after a sweep "
-                "to place its returns; a higher --pose-rate (at most 1000 Hz) keeps them",
-                lost, sim.NumSweepsInRun(), sim.PoseOffsetUs(sim.NumPoses() - 1) * 1e-6,
-                sim.pose_rate_hz());
+                "warning: %d of the scenario's %d sweeps %s after its last pose (%.3f s into the "
+                "run at %g Hz), and the tracker needs a pose after a sweep to place its returns; "
+                "a higher %s (at most 1000 Hz) keeps them",
+                lost, sim.NumSweepsInRun(),
+                left_out_here ? "are left out: they end" : "cannot be tracked: they end",
+                sim.PoseOffsetUs(sim.NumPoses() - 1) * 1e-6, sim.pose_rate_hz(),
+                rate_setting.c_str());
   return buf;
 }
 

@@ -46,8 +46,12 @@ SimCli ReadSimCli(const boost::program_options::variables_map& vm);
 std::unique_ptr<Simulator> MakeSimulator(const SimCli& cli);
 
 // Empty, or a warning that the pose rate leaves the last sweeps of the run out (no pose follows
-// them), with how many and what rate would keep them.
-std::string SweepsLeftOutWarning(const Simulator& sim);
+// them), with how many and what rate would keep them; rate_setting names where the user sets
+// that rate for this program ("--pose-rate", or the scenario's key). left_out_here: the program
+// leaves those sweeps out itself (a log, the driver's lap), rather than publishing poses that
+// end before them (vtrack-ego-pose).
+std::string SweepsLeftOutWarning(const Simulator& sim, const std::string& rate_setting,
+                                 bool left_out_here);
 
 // Parses argv against desc; prints help (with usage) and returns false if --help was given.
 // Throws boost::program_options::error on bad options.

@@ -160,6 +160,25 @@ TEST(SimLogTest, SweepsLeftOutByALowPoseRateAreCountedInAWarning) {
                    dir + "/out.txt"),
             0);
   EXPECT_EQ(ReadFile(dir + "/out.txt"), "");
+
+  // Live, vtrack-ego-pose at that rate (memq://: no network) warns of the same sweeps, which the
+  // driver, following the scenario's rate, still publishes; at the scenario's rate it does not.
+  const auto ego_pose = [&](const std::vector<std::string>& rate) {
+    std::vector<std::string> argv{BinDir() + "/vtrack-ego-pose", "--scenario",
+                                  "paper_fig5_follow_clutter", "--duration", "6", "--lcm-url",
+                                  "memq://", "--stop-after", "0.2", "-q"};
+    argv.insert(argv.end(), rate.begin(), rate.end());
+    EXPECT_EQ(RunCommand(argv, dir + "/ego.txt"), 0) << ReadFile(dir + "/ego.txt");
+    return ReadFile(dir + "/ego.txt");
+  };
+  const std::string low = ego_pose({"--pose-rate", "2"});
+  EXPECT_NE(low.find("vtrack-ego-pose: warning: " + std::to_string(150 - scans) +
+                     " of the scenario's 150 sweeps cannot be tracked"),
+            std::string::npos)
+      << low;
+  EXPECT_NE(low.find("a higher --pose-rate"), std::string::npos) << low;
+  const std::string usual = ego_pose({});
+  EXPECT_EQ(usual.find("warning"), std::string::npos) << usual;
 }
 
 Eigen::Isometry3d PoseOf(const pose_t& p) {

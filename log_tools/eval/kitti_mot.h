@@ -116,9 +116,10 @@ struct KittiObject {
 std::vector<KittiObject> ReadTrackingFile(const std::string& path, bool is_result,
                                           std::int64_t* last_frame = nullptr);
 
-// The number of rows of `result` in frames after last_label_frame: the labels say nothing of
-// those frames, so each such row is a false positive, and many of them usually mean that the
-// results are of another sequence or counted from another first frame.
+// The number of rows of `result` in frames after last_label_frame: no labelled object lies in
+// those frames, so each such car row that is not ignored (a Van, 25 px or less) is a false
+// positive, and many of them usually mean that the results are of another sequence or counted
+// from another first frame.
 std::int64_t RowsAfterFrame(const std::vector<KittiObject>& result, std::int64_t last_label_frame);
 
 struct Params {

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -261,16 +262,21 @@ int main(int argc, char** argv) {
       const auto gt = ReadTrackingFile(labels_path, false, &last_label_frame);
       const auto res = ReadTrackingFile(results_path, true);
       if (const std::int64_t after = RowsAfterFrame(res, last_label_frame); after > 0) {
-        std::int64_t last_result_frame = -1;
-        for (const auto& r : res) last_result_frame = std::max(last_result_frame, r.frame);
+        std::int64_t first = std::numeric_limits<std::int64_t>::max(), last = -1;
+        for (const auto& r : res) {
+          if (r.frame <= last_label_frame) continue;
+          first = std::min(first, r.frame);
+          last = std::max(last, r.frame);
+        }
         // Printed with -q too: the score counts these rows, and the cause is usually a mix-up.
         std::fprintf(stderr,
                      "vtrack-eval-kitti: warning: %s: %lld car/van rows in frames %lld-%lld, after "
-                     "the last labelled frame (%lld) of %s; each is a false positive (results of "
-                     "another sequence, or frames numbered from another start?)\n",
+                     "frame %lld, the last with a row in %s; they are scored against no object, "
+                     "each car not ignored a false positive (results of another sequence, or "
+                     "frames numbered from another first frame? expected only if the sequence's "
+                     "last frames hold no object)\n",
                      results_path.c_str(), static_cast<long long>(after),
-                     static_cast<long long>(last_label_frame + 1),
-                     static_cast<long long>(last_result_frame),
+                     static_cast<long long>(first), static_cast<long long>(last),
                      static_cast<long long>(last_label_frame), labels_path.c_str());
       }
       prepared.push_back(std::make_unique<PreparedSequence>(name, gt, res, o.params));

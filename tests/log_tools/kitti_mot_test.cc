@@ -518,8 +518,8 @@ TEST_F(KittiMotCliTest, ResultsAfterTheLastLabelledFrameAreFalsePositivesAndWarn
                     &out),
             0)
       << out;
-  EXPECT_NE(out.find("warning: " + dir_ + "/late/0000.txt: 2 car/van rows in frames 3-7, after "
-                     "the last labelled frame (2)"),
+  EXPECT_NE(out.find("warning: " + dir_ + "/late/0000.txt: 2 car/van rows in frames 5-7, after "
+                     "frame 2, the last with a row in " + dir_ + "/labels/0000.txt"),
             std::string::npos)
       << out;
   // Counted: the hand case's 2 false positives and these 2; 6 labelled cars, 1 miss, 1 switch.

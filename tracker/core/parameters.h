@@ -712,7 +712,7 @@ struct EvidenceParams {
     v("accumulation", &accumulation, {"-", {}, "sum: L += scan_weight (l - logit(prior)); average: L += scan_weight (l - L), an exponential average of the scans' log posterior odds (scans of one object are far from independent); fitted (the better log-likelihood)"});
     v("scan_weight", &scan_weight, {"-", OpenClosed(0, 1), "the weight of each scan in the accumulation; fitted"});
     v("max_log_odds", &max_log_odds, {"-", Above(0), "the accumulated log-odds are clamped to +-this, so that a track can change its mind"});
-    v("vehicle_probability", &vehicle_probability, {"-", Open(0, 1), "a track becomes a vehicle when its accumulated probability reaches this (0.5: a report is more likely right than wrong, what MOTA counts)"});
+    v("vehicle_probability", &vehicle_probability, {"-", Open(0, 1), "a track becomes a vehicle when its accumulated probability reaches this (0.5: a report is more likely right than wrong, what MOTA counts; on KITTI 0000 0.4 and 0.6 both score lower in every mode, docs/design.md section 4.10a)"});
     v("keep_probability", &keep_probability, {"-", OpenClosed(0, 1), "a vehicle stays one while its accumulated probability is at least this (<= vehicle_probability; a run of weak scans then does not flip it, each flip cost a fragment); fitted: the fewest held-out wrong decisions"});
     v("model_3d", &model_3d, {"-", {}, "3-D scans: logistic (bias_3d + terms_3d) or trees (bias_3d + trees_3d); fitted: the better held-out log-likelihood"});
     v("bias_3d", &bias_3d, {"-", Finite(), "3-D scans: intercept of the per-scan logit"});

@@ -377,9 +377,15 @@ std::vector<int> MatchMostPairsMinCost(const std::vector<double>& cost,
   return result;
 }
 
-std::int64_t RowsAfterFrame(const std::vector<KittiObject>& result, std::int64_t last_label_frame) {
-  return std::count_if(result.begin(), result.end(),
-                       [&](const KittiObject& o) { return o.frame > last_label_frame; });
+RowsAfter RowsAfterFrame(const std::vector<KittiObject>& result, std::int64_t last_label_frame) {
+  RowsAfter a;
+  for (const KittiObject& o : result) {
+    if (o.frame <= last_label_frame) continue;
+    a.first_frame = a.count == 0 ? o.frame : std::min(a.first_frame, o.frame);
+    a.last_frame = std::max(a.last_frame, o.frame);
+    ++a.count;
+  }
+  return a;
 }
 
 PreparedSequence::PreparedSequence(std::string name, const std::vector<KittiObject>& gt,

@@ -116,11 +116,16 @@ struct KittiObject {
 std::vector<KittiObject> ReadTrackingFile(const std::string& path, bool is_result,
                                           std::int64_t* last_frame = nullptr);
 
-// The number of rows of `result` in frames after last_label_frame: no labelled object lies in
-// those frames, so each such car row that is not ignored (a Van, 25 px or less) is a false
-// positive, and many of them usually mean that the results are of another sequence or counted
-// from another first frame.
-std::int64_t RowsAfterFrame(const std::vector<KittiObject>& result, std::int64_t last_label_frame);
+// The rows of `result` in frames after last_label_frame: no labelled object lies in those
+// frames, so each such car row that is not ignored (a Van, 25 px or less) is a false positive,
+// and many of them usually mean that the results are of another sequence or counted from
+// another first frame.
+struct RowsAfter {
+  std::int64_t count = 0;
+  std::int64_t first_frame = -1;  // of those rows; -1 if there are none
+  std::int64_t last_frame = -1;
+};
+RowsAfter RowsAfterFrame(const std::vector<KittiObject>& result, std::int64_t last_label_frame);
 
 struct Params {
   double min_iou = 0.25;         // rule 4: a match needs IoU >= this; (0, 1]

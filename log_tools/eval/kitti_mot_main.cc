@@ -10,7 +10,6 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <limits>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -261,13 +260,7 @@ int main(int argc, char** argv) {
       std::int64_t last_label_frame = -1;
       const auto gt = ReadTrackingFile(labels_path, false, &last_label_frame);
       const auto res = ReadTrackingFile(results_path, true);
-      if (const std::int64_t after = RowsAfterFrame(res, last_label_frame); after > 0) {
-        std::int64_t first = std::numeric_limits<std::int64_t>::max(), last = -1;
-        for (const auto& r : res) {
-          if (r.frame <= last_label_frame) continue;
-          first = std::min(first, r.frame);
-          last = std::max(last, r.frame);
-        }
+      if (const RowsAfter late = RowsAfterFrame(res, last_label_frame); late.count > 0) {
         // Printed with -q too: the score counts these rows, and the cause is usually a mix-up.
         std::fprintf(stderr,
                      "vtrack-eval-kitti: warning: %s: %lld car/van rows in frames %lld-%lld, after "
@@ -275,8 +268,9 @@ int main(int argc, char** argv) {
                      "each car not ignored a false positive (results of another sequence, or "
                      "frames numbered from another first frame? expected only if the sequence's "
                      "last frames hold no object)\n",
-                     results_path.c_str(), static_cast<long long>(after),
-                     static_cast<long long>(first), static_cast<long long>(last),
+                     results_path.c_str(), static_cast<long long>(late.count),
+                     static_cast<long long>(late.first_frame),
+                     static_cast<long long>(late.last_frame),
                      static_cast<long long>(last_label_frame), labels_path.c_str());
       }
       prepared.push_back(std::make_unique<PreparedSequence>(name, gt, res, o.params));

@@ -70,7 +70,9 @@ int main(int argc, char** argv) {
                  sim->scenario().name.c_str(), sim->sensor().name.c_str(),
                  sim->sensor().NumLayers(), sim->sensor().rate_hz, sim->sensor().NumColumns(),
                  static_cast<unsigned long long>(sim->seed()), sim->NumScans());
-    if (const std::string w = vtrack::sim::SweepsLeftOutWarning(*sim, "pose_rate_hz in the scenario", true); !w.empty()) {
+    if (const std::string w =
+            vtrack::sim::SweepsLeftOutWarning(*sim, "pose_rate_hz in the scenario", true);
+        !w.empty()) {
       std::fprintf(stderr, "vtrack-ladar-driver: %s\n", w.c_str());
     }
     return std::make_unique<vtrack::sim::SimScanTimeline>(sim, lcm, output, truth_channel);

@@ -80,7 +80,8 @@ int main(int argc, char** argv) {
                    sim->sensor().rate_hz, static_cast<unsigned long long>(sim->seed()),
                    sim->NumScans(), sim->NumPoses(), sim->pose_rate_hz(), out.c_str());
     }
-    if (const std::string w = vtrack::sim::SweepsLeftOutWarning(*sim, "--pose-rate", true); !w.empty()) {
+    if (const std::string w = vtrack::sim::SweepsLeftOutWarning(*sim, "--pose-rate", true);
+        !w.empty()) {
       std::fprintf(stderr, "vtrack-sim-log: %s\n", w.c_str());
     }
     const auto t0 = std::chrono::steady_clock::now();

@@ -187,11 +187,21 @@ TEST(KittiMotFiles, ReadsClassesAndRejectsMalformedLines) {
   WriteFile(dir + "/empty.txt", "\n");
   EXPECT_TRUE(ReadTrackingFile(dir + "/empty.txt", false, &last_frame).empty());
   EXPECT_EQ(last_frame, -1);
-  std::vector<KittiObject> rows(5);
-  for (int f = 0; f < 5; ++f) rows[static_cast<std::size_t>(f)].frame = f;
-  EXPECT_EQ(RowsAfterFrame(rows, 2), 2);
-  EXPECT_EQ(RowsAfterFrame(rows, 4), 0);
-  EXPECT_EQ(RowsAfterFrame(rows, -1), 5);
+  // Frames 4, 0, 3, 1, 2 (out of order, as rows of several tracks may come).
+  std::vector<KittiObject> rows;
+  for (const std::int64_t f : {4, 0, 3, 1, 2}) rows.emplace_back().frame = f;
+  const RowsAfter two = RowsAfterFrame(rows, 2);
+  EXPECT_EQ(two.count, 2);
+  EXPECT_EQ(two.first_frame, 3);
+  EXPECT_EQ(two.last_frame, 4);
+  const RowsAfter none = RowsAfterFrame(rows, 4);
+  EXPECT_EQ(none.count, 0);
+  EXPECT_EQ(none.first_frame, -1);
+  EXPECT_EQ(none.last_frame, -1);
+  const RowsAfter all = RowsAfterFrame(rows, -1);
+  EXPECT_EQ(all.count, 5);
+  EXPECT_EQ(all.first_frame, 0);
+  EXPECT_EQ(all.last_frame, 4);
 
   // A result without the score column reads as score -1 (AB3DMOT).
   WriteFile(dir + "/res17.txt", Line(car, false));
